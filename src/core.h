@@ -1,0 +1,59 @@
+// core.h — results, error messages, checked sizes and atomic file writes shared by every rouge module.
+//
+// Does: the rs_result enum and rs_error detail buffer that every fallible call fills; overflow-checked
+// size arithmetic; whole-file reads with a size cap; atomic writes (temp file + fsync + rename).
+// Does not: print anything (only the app's main prints), or own any global state.
+//
+//   rs_error err = {0};
+//   void *data; size_t len;
+//   if (rs_file_read_all("face.rsf", 1u << 30, &data, &len, &err) != RS_OK)
+//       fprintf(stderr, "rouge: %s\n", err.msg);
+//   free(data);
+#ifndef RS_CORE_H
+#define RS_CORE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+typedef enum rs_result {
+    RS_OK = 0,
+    RS_ERR_IO,      // file system: missing, unreadable, unwritable, a directory
+    RS_ERR_FORMAT,  // file contents are malformed
+    RS_ERR_LIMIT,   // a count or size exceeds what we accept
+    RS_ERR_NOMEM,   // allocation failed
+    RS_ERR_GL,      // no usable GLES 3 context, shader compile/link error, incomplete FBO
+    RS_ERR_ARG,     // bad option or argument from the caller/user
+} rs_result;
+
+// One-line, human-readable detail of the last failure ("face.rsf: header: bad CRC (byte 8)").
+typedef struct rs_error {
+    rs_result code;
+    char msg[512];
+} rs_error;
+
+// Fills err (if non-NULL) and returns code, so callers can `return rs_fail(err, RS_ERR_IO, "...", ...)`.
+rs_result rs_fail(rs_error *err, rs_result code, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+const char *rs_result_name(rs_result r);
+
+// Overflow-checked arithmetic: false on overflow, *out untouched.
+bool rs_size_mul(size_t a, size_t b, size_t *out);
+bool rs_size_add(size_t a, size_t b, size_t *out);
+// malloc(a*b) with an overflow check; NULL on overflow or out of memory.
+void *rs_alloc_array(size_t count, size_t elem_size);
+
+// Reads a whole regular file (refuses directories, devices and files larger than max_bytes).
+rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, size_t *out_len, rs_error *err);
+// Writes via "<path>.tmp.<pid>" then fsync + rename: readers see the old or the new file, never a mix.
+rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err);
+
+// Monotonic clock in seconds, for benches and adaptive LOD (never for test assertions).
+double rs_time_now(void);
+
+#define RS_COUNT_OF(a) (sizeof(a) / sizeof((a)[0]))
+#define RS_MIN(a, b) ((a) < (b) ? (a) : (b))
+#define RS_MAX(a, b) ((a) > (b) ? (a) : (b))
+#define RS_CLAMP(x, lo, hi) RS_MIN(RS_MAX((x), (lo)), (hi))
+
+#endif

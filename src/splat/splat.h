@@ -1,0 +1,116 @@
+// splat.h — the splat cloud in memory and the compact .rsf file format (docs/rsf.md).
+//
+// Does: hold a face as splats (packed 16-byte records, GPU-ready, plus decoded float copies for the CPU);
+// encode float splats into records; load/validate and save .rsf files (atomic write); LOD prefixes;
+// region table with the specular parameters; the face frame (centre, forward, up) used by the camera
+// and by mirror painting.
+// Does not: touch GL (the renderer uploads `packed` as is), read PLY (tools/ply.c), or paint.
+//
+//   rs_error err = {0};
+//   rs_splat_cloud *c = NULL;
+//   if (rs_splat_load("assets/face.rsf", &c, &err) != RS_OK) { puts(err.msg); return 1; }
+//   uint32_t n = rs_splat_lod_count(c, 50000);   // largest LOD prefix with <= 50k splats
+//   rs_splat_destroy(c);
+#ifndef RS_SPLAT_H
+#define RS_SPLAT_H
+
+#include "../core.h"
+
+#define RS_SPLAT_MAX_LODS 24
+#define RS_SPLAT_MAX_REGIONS 16
+#define RS_SPLAT_MAX_NOTES 8192         // attribution / provenance text carried from the source scan
+#define RS_SPLAT_MAX_COUNT (64u << 20)  // 64M splats: far above any face scan, keeps sizes in 32 bits
+
+// Built-in region ids (the region table may add more after these).
+typedef enum rs_region {
+    RS_REGION_OTHER = 0,  // other skin (ears, neck, scalp, eyelids, chin...)
+    RS_REGION_CHEEK = 1,
+    RS_REGION_NOSE = 2,
+    RS_REGION_FOREHEAD = 3,
+    RS_REGION_LIPS = 4,
+    RS_REGION_BUILTIN_COUNT = 5,
+} rs_region;
+
+// One splat as floats, in model units. Colour is sRGB-encoded 8-bit, as in the scan.
+typedef struct rs_splat {
+    float pos[3];
+    float normal[3];   // unit length, pointing out of the surface
+    float radius;      // disk radius, model units
+    uint8_t rgb[3];    // sRGB
+    uint8_t region;    // index into the region table
+} rs_splat;
+
+// The 16-byte record stored in the file and in the GPU buffer (read in shaders as one uvec4):
+//   w[0] = x16 | y16 << 16                      position, unorm16 over the bounding box
+//   w[1] = z16 | radius8 << 16 | region8 << 24  radius log-quantized over [radius_min, radius_max]
+//   w[2] = oct_u16 | oct_v16 << 16              normal, octahedral, snorm16 (max error ~0.003 deg)
+//   w[3] = r8 | g8 << 8 | b8 << 16 | flags8 << 24   sRGB colour; flags reserved (0)
+typedef struct rs_splat_packed {
+    uint32_t w[4];
+} rs_splat_packed;
+
+typedef struct rs_region_info {
+    char name[16];     // "cheek", NUL-terminated
+    float m;           // Beckmann roughness
+    float rho_s;       // specular scale (Kelemen/Szirmay-Kalos, GPU Gems 3 convention)
+} rs_region_info;
+
+typedef struct rs_splat_header {
+    uint32_t count;
+    float bbox_min[3], bbox_max[3];  // quantization frame, model units
+    float radius_min, radius_max;    // log-quantization range of radii, model units
+    float mm_per_unit;               // physical scale (diffusion widths are in mm)
+    // Face frame: camera yaw/pitch 0 looks at the face from `forward`; mirror plane goes through
+    // `centre` with normal cross(up, forward).
+    float centre[3], forward[3], up[3];
+    float face_height;               // model units; brush sizes are fractions of this
+    uint32_t lod_count;              // LOD table: prefix lengths, descending, lods[0] == count
+    uint32_t lods[RS_SPLAT_MAX_LODS];
+    uint32_t region_count;
+    rs_region_info regions[RS_SPLAT_MAX_REGIONS];
+    uint32_t flags;                  // reserved, 0
+    char notes[RS_SPLAT_MAX_NOTES];  // attribution (CC-BY) and provenance, NUL-terminated UTF-8
+} rs_splat_header;
+
+typedef struct rs_splat_cloud {
+    rs_splat_header hdr;
+    rs_splat_packed *packed;  // hdr.count records, in LOD order
+    // Decoded from `packed` at load (what the renderer will see), for picking, brushes and tests.
+    float (*pos)[3];
+    float (*normal)[3];
+    float *radius;
+    uint32_t region_counts[RS_SPLAT_MAX_REGIONS];
+} rs_splat_cloud;
+
+// Fills the region table with the five built-in regions and Weyrich et al.'s means
+// (other skin = mean of the four measured regions).
+void rs_splat_default_regions(rs_splat_header *hdr);
+
+// Builds a cloud from float splats already in LOD order (the converter orders them). `hdr` supplies
+// mm_per_unit, face frame, LOD table, regions and notes; count/bbox/radius range are computed here.
+rs_result rs_splat_create(const rs_splat *splats, uint32_t count, const rs_splat_header *hdr,
+                          rs_splat_cloud **out, rs_error *err);
+void rs_splat_destroy(rs_splat_cloud *c);
+
+// Loads and fully validates a .rsf file (magic, version, sizes, CRC32, finite floats, LOD and region
+// tables, field ranges). Errors name the field and byte offset.
+rs_result rs_splat_load(const char *path, rs_splat_cloud **out, rs_error *err);
+rs_result rs_splat_load_memory(const void *data, size_t len, rs_splat_cloud **out, rs_error *err);
+// Serialises to .rsf (atomic: temp file + rename).
+rs_result rs_splat_save(const rs_splat_cloud *c, const char *path, rs_error *err);
+rs_result rs_splat_save_memory(const rs_splat_cloud *c, void **out_data, size_t *out_len, rs_error *err);
+
+// Decodes record i (as the GPU sees it).
+void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out);
+// Largest LOD prefix from the table with at most max_count splats (the smallest level if none fits).
+uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count);
+// Radius multiplier for drawing only the first n splats: sqrt(count / n).
+float rs_splat_lod_radius_scale(const rs_splat_cloud *c, uint32_t n);
+
+// Octahedral normal coding, exposed for tests and shaders' CPU mirror.
+uint32_t rs_splat_encode_normal(const float n[3]);
+void rs_splat_decode_normal(uint32_t code, float n[3]);
+
+uint32_t rs_crc32(uint32_t crc, const void *data, size_t len);
+
+#endif
