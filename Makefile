@@ -11,7 +11,8 @@ BUILD    ?= build
 PKGS     := egl glesv2 glfw3 libpng cglm
 CC       ?= cc
 OPT      ?= -O2
-CFLAGS   := -std=c11 $(OPT) -g -Wall -Wextra -Werror -MMD -MP $(EXTRA_CFLAGS)
+# Messages are cut to their buffers on purpose, so GCC's format-truncation guesses are not errors.
+CFLAGS   := -std=c11 $(OPT) -g -Wall -Wextra -Werror -Wno-format-truncation -MMD -MP $(EXTRA_CFLAGS)
 LDFLAGS  := $(EXTRA_LDFLAGS)
 
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
@@ -54,7 +55,7 @@ $(BUILD)/gen/shaders.c: $(BUILD)/embed_shaders $(SHADERS)
 
 $(BUILD)/obj/gen/shaders.o: $(BUILD)/gen/shaders.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -Isrc -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -c $< -o $@
 
 $(BUILD)/librouge.a: $(LIB_OBJ)
 	@rm -f $@

@@ -1,0 +1,31 @@
+// cli.h — command-line parsing shared by `rouge render` and `rouge view`: one table of options that
+// fill an rs_view plus the file arguments. Errors are returned as one-line messages, never printed here.
+//
+//   rs_cli cli;
+//   if (rs_cli_parse(argc - 2, argv + 2, &cli, &err) != RS_OK) { fprintf(stderr, "rouge: %s\n", err.msg); }
+//   rs_render_image(r, &cli.view, &img, &err);
+#ifndef RS_APP_CLI_H
+#define RS_APP_CLI_H
+
+#include "render/render.h"
+
+#include <stdio.h>
+
+typedef struct rs_cli {
+    const char *face;       // FACE.rsf (positional)
+    const char *output;     // -o PNG
+    const char *strokes;    // --strokes FILE: replay painting
+    const char *look;       // --look FILE: apply a saved look
+    const char *save_look;  // --save-look FILE: save the look after replaying strokes
+    const char *record;     // --record FILE: viewer records strokes
+    rs_view view;
+    bool view_set[4];       // which of yaw/pitch/zoom/fov were given (strokes files carry a view)
+    bool fullscreen;
+    bool help;
+} rs_cli;
+
+rs_result rs_cli_parse(int argc, char **argv, bool allow_output, rs_cli *out, rs_error *err);
+// The options table as help text (one option per line).
+void rs_cli_print_options(FILE *f);
+
+#endif

@@ -1,0 +1,130 @@
+// render.h — the splat renderer: the paper's five stages (shadow map, visibility splatting, attribute
+// splatting, splat-based diffusion, composite F = A(D + S)) in a reference and a mobile pipeline.
+//
+// Does: upload a splat cloud (the packed 16-byte records, as is) and its makeup layer (8-byte records);
+// render a view into the renderer's own RGBA8 output texture (headless and windowed alike); read it
+// back; pick the splat under a pixel through an ID buffer; update makeup records by sub-range.
+// Does not: create the GL context (gl/gl.h), handle input, or own the makeup layer's CPU state.
+// Stage code lives in the file named after it: render_shadow.c, render_visibility.c,
+// render_attribute.c, render_diffusion.c, render_composite.c; render_pick.c is the ID buffer.
+//
+//   rs_renderer *r;
+//   if (rs_render_create(&(rs_render_desc){.cloud = cloud, .caps = rs_gl_get_caps(gl)}, &r, &err)) return 1;
+//   rs_view v = rs_view_defaults();  v.width = v.height = 512;  v.mode = RS_MODE_FULL;
+//   rs_image img = {0};
+//   if (rs_render_image(r, &v, &img, &err) == RS_OK) rs_image_write_png("face.png", &img, &err);
+//   rs_render_destroy(r);
+#ifndef RS_RENDER_H
+#define RS_RENDER_H
+
+#include "core.h"
+#include "gl/gl.h"
+#include "image.h"
+#include "splat/splat.h"
+
+typedef enum rs_render_mode {
+    RS_MODE_FULL = 0,   // subsurface + specular (paper Fig. 7 right)
+    RS_MODE_ALBEDO,     // no lighting (Fig. 7 left)
+    RS_MODE_DIFFUSE,    // subsurface only (Fig. 7 middle): A * D
+    RS_MODE_SPECULAR,   // S alone (debug)
+    RS_MODE_NORMALS,    // interpolated normals as colour (debug)
+    RS_MODE_REGIONS,    // face regions as flat colours (debug)
+    RS_MODE_SHADOW,     // light visibility from the shadow map (debug)
+    RS_MODE_LOD,        // splat LOD level as colour (debug)
+    RS_MODE_IRRADIANCE, // plain per-pixel N.L * shadow, no diffusion (the test baseline for diffusion)
+    RS_MODE_COUNT
+} rs_render_mode;
+
+typedef enum rs_pipeline {
+    RS_PIPELINE_REFERENCE = 0,  // six Gaussians, all splats: the quality bar
+    RS_PIPELINE_MOBILE,         // LOD decimation + reduced kernel count, matched within a stated tolerance
+} rs_pipeline;
+
+typedef enum rs_composite {
+    RS_COMPOSITE_PAPER = 0,     // F = A (D + S), paper eq. 1
+    RS_COMPOSITE_PHYSICAL,      // F = A D + S (specular not tinted by albedo)
+} rs_composite;
+
+typedef enum rs_splat_prim {
+    RS_PRIM_AUTO = 0,           // point sprites when the needed size fits GL_ALIASED_POINT_SIZE_RANGE
+    RS_PRIM_POINTS,
+    RS_PRIM_QUADS,              // instanced screen-aligned quads
+} rs_splat_prim;
+
+typedef struct rs_light {
+    float yaw_deg, pitch_deg;   // direction the light comes FROM, in the face frame (0,0 = from the front)
+    float color[3];             // linear RGB; zero means white
+    float intensity;            // zero means 1 for the key light
+} rs_light;
+
+typedef struct rs_view {
+    int width, height;          // pixels
+    // Camera orbiting the face centre in the face frame (yaw 0, pitch 0: frontal).
+    float yaw_deg, pitch_deg;
+    float zoom;                 // 1: the face height fills ~80% of the view height; 2: twice as close
+    float fov_deg;              // vertical field of view
+    float pan[2];               // screen-space pan, fractions of the view height
+    rs_light key;
+    rs_light fill;              // second light; used when fill.intensity > 0
+    rs_render_mode mode;
+    rs_pipeline pipeline;
+    rs_composite composite;
+    float exposure;             // linear multiplier before sRGB encoding
+    float background[3];        // sRGB 0..1
+    bool no_shadows;
+    bool hide_makeup;           // render the bare face (before/after split)
+    float rho_s_scale;          // multiplies every rho_s (tests, paper Fig. 11); 0 means 1
+    uint32_t max_splats;        // cap on the LOD prefix drawn (0: pipeline decides)
+    int kernel_count;           // mobile pipeline: K Gaussians (0: default)
+    rs_splat_prim prim;         // primitive choice (AUTO by caps)
+} rs_view;
+
+// Defaults: 512x512, frontal, zoom 1, fov 30, key light from upper left-front, fill off, full mode,
+// reference pipeline, exposure 1, dark grey background.
+rs_view rs_view_defaults(void);
+
+typedef struct rs_render_desc {
+    const rs_splat_cloud *cloud;     // kept by pointer: must outlive the renderer
+    const rs_gl_caps *caps;
+    bool force_no_float_targets;     // test the RGBA8 fallback path on drivers that have float targets
+} rs_render_desc;
+
+typedef struct rs_renderer rs_renderer;
+
+typedef struct rs_render_stats {
+    uint32_t splats_drawn;           // main passes
+    uint32_t diffusion_splats;       // summed over diffusion levels
+    int kernel_count;
+    bool used_points;                // point sprites (true) or instanced quads (false)
+    bool float_targets;
+    size_t gpu_bytes;                // buffers + textures owned by the renderer
+} rs_render_stats;
+
+rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_error *err);
+void rs_render_destroy(rs_renderer *r);
+
+// Renders into the renderer's output texture (resized to the view as needed).
+rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err);
+// The RGBA8 output texture of the last frame (for the viewer to draw), and its size.
+GLuint rs_render_output_texture(const rs_renderer *r, int *width, int *height);
+// Reads the last frame back into a new RGBA image (rows top-first).
+rs_result rs_render_read(rs_renderer *r, rs_image *out, rs_error *err);
+// rs_render_frame + rs_render_read.
+rs_result rs_render_image(rs_renderer *r, const rs_view *view, rs_image *out, rs_error *err);
+
+// ID buffer: the visible splat under pixel (x, y) (top-left origin) for this view. False on background.
+bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t *splat_index);
+// Pixels per model unit at a model-space point for this view (brush size on screen).
+float rs_render_pixels_per_unit(const rs_renderer *r, const rs_view *view, const float pos[3]);
+// Unit vector from a model-space point towards the camera.
+void rs_render_view_dir(const rs_renderer *r, const rs_view *view, const float pos[3], float dir[3]);
+// Projects a model-space point to pixels (top-left origin); false when behind the camera.
+bool rs_render_project(const rs_renderer *r, const rs_view *view, const float pos[3], float px[2]);
+
+// Makeup layer records (rs_makeup_gpu, 8 bytes each) for splats [first, first + count).
+rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count, const void *records,
+                                  rs_error *err);
+
+rs_render_stats rs_render_get_stats(const rs_renderer *r);
+
+#endif
