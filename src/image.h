@@ -27,7 +27,8 @@ typedef struct rs_image {
 
 typedef struct rs_image_metrics {
     double psnr;        // dB over RGB samples; INFINITY when identical
-    double ssim;        // mean SSIM of luminance, 11x11 Gaussian window (sigma 1.5), 1.0 when identical
+    double ssim;        // mean SSIM of BT.709 luma of the sRGB values, 11x11 Gaussian window (sigma 1.5;
+                        // smaller images use the largest odd window that fits), 1.0 when identical
     int max_abs;        // largest per-channel difference (RGB), 0..255
     double mean_abs;    // mean per-channel absolute difference (RGB)
     double delta_e;     // mean CIEDE2000 over pixels (sRGB D65 -> Lab)

@@ -84,8 +84,17 @@ void rs_test_skip(const char *fmt, ...)
 const char *rs_test_out_dir(void)
 {
     if (!T.out_dir[0]) {
-        const char *b = getenv("RS_TEST_OUT");
-        snprintf(T.out_dir, sizeof T.out_dir, "%s", b && *b ? b : "build/test-out");
+        const char *o = getenv("RS_TEST_OUT");
+        const char *b = getenv("RS_BUILD");
+        if (o && *o) snprintf(T.out_dir, sizeof T.out_dir, "%s", o);
+        else snprintf(T.out_dir, sizeof T.out_dir, "%s/test-out", b && *b ? b : "build");
+        // mkdir -p: tests may run straight from a build directory that has no test-out yet.
+        for (char *p = T.out_dir + 1; *p; p++)
+            if (*p == '/') {
+                *p = 0;
+                mkdir(T.out_dir, 0755);
+                *p = '/';
+            }
         mkdir(T.out_dir, 0755);
     }
     return T.out_dir;

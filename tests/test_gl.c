@@ -4,6 +4,7 @@
 #include "gl/gl.h"
 #include "gl/shader.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
