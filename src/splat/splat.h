@@ -88,6 +88,8 @@ void rs_splat_default_regions(rs_splat_header *hdr);
 
 // Builds a cloud from float splats already in LOD order (the converter orders them). `hdr` supplies
 // mm_per_unit, face frame, LOD table, regions and notes; count/bbox/radius range are computed here.
+// Zero fields (or hdr == NULL) take defaults: mm_per_unit 1, forward +z, up +y, face_height the bbox
+// extent along up, LOD table {count}, rs_splat_default_regions. forward/up are stored orthonormalised.
 rs_result rs_splat_create(const rs_splat *splats, uint32_t count, const rs_splat_header *hdr,
                           rs_splat_cloud **out, rs_error *err);
 void rs_splat_destroy(rs_splat_cloud *c);
