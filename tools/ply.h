@@ -6,6 +6,9 @@
 // texture_u texture_v), an optional per-vertex `region` (uchar/int), and `face` lists (polygons are
 // fan-triangulated). Unknown elements and properties are skipped. Every count is checked against the
 // bytes that remain before anything is allocated, so allocations are capped by the file size.
+// ASCII bodies are one record per line. Limits: header 64 KiB, header lines 4096 bytes, 64 elements,
+// 512 properties. `tri` is NULL exactly when tri_count is 0 (faces with < 3 indices are skipped, but
+// their indices are still validated). Numbers are parsed in the C locale (never set LC_NUMERIC).
 // Does not: write PLY, or keep any property not listed above.
 //
 //   rs_ply_mesh *m = NULL;
