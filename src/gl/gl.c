@@ -55,7 +55,8 @@ static bool egl_try_display(rs_gl_context *c, EGLDisplay dpy, char *why, size_t 
         eglTerminate(dpy);
         return false;
     }
-    const EGLint cfg_attr[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_NONE};
+    // Surfaceless configs have no window bit, which eglChooseConfig asks for by default.
+    const EGLint cfg_attr[] = {EGL_SURFACE_TYPE, 0, EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_NONE};
     EGLConfig cfg;
     EGLint ncfg = 0;
     if (!eglChooseConfig(dpy, cfg_attr, &cfg, 1, &ncfg) || ncfg < 1) {
