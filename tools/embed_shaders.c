@@ -1,6 +1,8 @@
 // embed_shaders — build step: turns shaders_es/*.glsl into a C table (build/gen/shaders.c) so the binary
-// carries its shaders. Resolves `#include "name.glsl"` and emits `#line LINE FILE_INDEX` directives so
-// compile errors can be mapped back to the file and line (src/gl/shader.c does the mapping).
+// carries its shaders. Resolves `#include "name.glsl"` and emits `#line` directives whose number encodes
+// the file as well: (file_index + 1) * RS_SHADER_LINE_BASE + line. Drivers disagree on reporting the
+// #line source-string number (Mesa always prints 0), but all of them report the line, so
+// src/gl/shader.c decodes file and line from it.
 // Usage: embed_shaders SHADER_DIR OUT.c
 #define _POSIX_C_SOURCE 200809L
 #include <dirent.h>
@@ -9,6 +11,7 @@
 #include <string.h>
 
 #define MAX_FILES 256
+#define LINE_BASE 10000  // RS_SHADER_LINE_BASE in src/gl/shader.h
 
 static char *names[MAX_FILES];
 static int nfiles;
@@ -73,13 +76,13 @@ static int emit_file(FILE *out, int idx, int depth)
                 return 1;
             }
             char buf[64];
-            snprintf(buf, sizeof buf, "#line 1 %d\n", k);
+            snprintf(buf, sizeof buf, "#line %d\n", (k + 1) * LINE_BASE + 1);
             emit_str(out, buf);
             if (emit_file(out, k, depth + 1)) {
                 fclose(f);
                 return 1;
             }
-            snprintf(buf, sizeof buf, "#line %d %d\n", lineno + 1, idx);
+            snprintf(buf, sizeof buf, "#line %d\n", (idx + 1) * LINE_BASE + lineno + 1);
             emit_str(out, buf);
             continue;
         }
@@ -87,7 +90,7 @@ static int emit_file(FILE *out, int idx, int depth)
         // Number the first line after #version so the file's own lines map back correctly.
         if (lineno == 1 && strncmp(p, "#version", 8) == 0) {
             char buf[64];
-            snprintf(buf, sizeof buf, "#line 2 %d\n", idx);
+            snprintf(buf, sizeof buf, "#line %d\n", (idx + 1) * LINE_BASE + 2);
             emit_str(out, buf);
         }
     }

@@ -46,6 +46,8 @@ static const opt opts[] = {
     {"--save-look", OPT_PATH, "FILE", "save the look after replaying strokes", 0, 0},
     {"--record", OPT_PATH, "FILE", "viewer: record strokes to FILE", 0, 0},
     {"--fullscreen", OPT_FLAG, NULL, "viewer: start full-screen", 0, 0},
+    {"--events", OPT_PATH, "FILE", "viewer: replay an event script (format: see 'event scripts' below)", 0, 0},
+    {"--bench-orbit", OPT_INT, "N", "viewer: orbit for N frames, print the median frame time, exit", 1, 100000},
 };
 
 void rs_cli_print_options(FILE *f)
@@ -72,6 +74,7 @@ static rs_result parse_enum(const char *name, const char *v, rs_cli *c, rs_error
         for (int i = 0; i < RS_MODE_COUNT; i++)
             if (!strcmp(v, mode_names[i])) return c->view.mode = (rs_render_mode)i, RS_OK;
     } else if (!strcmp(name, "--pipeline")) {
+        c->pipeline_set = true;
         if (!strcmp(v, "reference")) return c->view.pipeline = RS_PIPELINE_REFERENCE, RS_OK;
         if (!strcmp(v, "mobile")) return c->view.pipeline = RS_PIPELINE_MOBILE, RS_OK;
     } else if (!strcmp(name, "--composite")) {
@@ -105,6 +108,7 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
             wd > o->hi || ht > o->hi)
             return rs_fail(err, RS_ERR_ARG, "--size: expected WxH with 16..8192 pixels each, got '%s'", v);
         w->width = wd, w->height = ht;
+        c->size_set = true;
         return RS_OK;
     }
     if (o->kind == OPT_RGB) {
@@ -138,6 +142,8 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--save-look")) c->save_look = v;
     else if (!strcmp(n, "--record")) c->record = v;
     else if (!strcmp(n, "--fullscreen")) c->fullscreen = true;
+    else if (!strcmp(n, "--events")) c->events = v;
+    else if (!strcmp(n, "--bench-orbit")) c->bench_orbit = (int)f;
     return RS_OK;
 }
 

@@ -11,6 +11,8 @@
 
 #include <stdio.h>
 
+// The viewer's options below exist (viewer.c reads them only then).
+
 typedef struct rs_cli {
     const char *face;       // FACE.rsf (positional)
     const char *output;     // -o PNG
@@ -18,8 +20,12 @@ typedef struct rs_cli {
     const char *look;       // --look FILE: apply a saved look
     const char *save_look;  // --save-look FILE: save the look after replaying strokes
     const char *record;     // --record FILE: viewer records strokes
+    const char *events;     // --events FILE: viewer replays an event script (tests, demos)
+    int bench_orbit;        // --bench-orbit N: viewer orbits N frames, prints frame times, exits (0: off)
     rs_view view;
     bool view_set[4];       // which of yaw/pitch/zoom/fov were given (strokes files carry a view)
+    bool size_set;          // --size given (the viewer's window size; default 1024x768)
+    bool pipeline_set;      // --pipeline given (the viewer defaults to mobile)
     bool fullscreen;
     bool help;
 } rs_cli;

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-// #line file number given to sources that are not in the embedded table (tests' inline sources).
+// Line block given to sources that are not in the embedded table (tests' inline sources).
 #define RS_SHADER_INLINE_FILE 999
 
 const char *rs_shader_find(const char *name)
@@ -16,18 +16,17 @@ const char *rs_shader_find(const char *name)
     return NULL;
 }
 
-// Finds "<file>:<line>" or "<file>(<line>)" in a driver log line (Mesa, NVIDIA, ANGLE styles).
-static bool parse_location(const char *s, int *file, int *line, const char **rest)
+// Finds "<string>:<line>" or "<string>(<line>)" in a driver log line (Mesa, NVIDIA, ANGLE styles).
+static bool parse_location(const char *s, int *line, const char **rest)
 {
     for (const char *p = s; *p; p++) {
         if (!isdigit((unsigned char)*p) || (p > s && isdigit((unsigned char)p[-1]))) continue;
         char *e;
-        long f = strtol(p, &e, 10);
+        (void)strtol(p, &e, 10);  // the source-string number: unreliable, the line encodes the file
         if (*e != ':' && *e != '(') continue;
         char *e2;
         long l = strtol(e + 1, &e2, 10);
         if (e2 == e + 1) continue;
-        *file = (int)f;
         *line = (int)l;
         while (*e2 == ')' || *e2 == ':' || *e2 == ' ' || *e2 == '(' || isdigit((unsigned char)*e2)) e2++;
         *rest = e2;
@@ -58,15 +57,17 @@ static void describe_log(const char *log, const char *stage_name, char *out, siz
     int n = nl ? (int)(nl - start) : (int)strlen(start);
     char first[512];
     snprintf(first, sizeof first, "%.*s", RS_MIN(n, (int)sizeof first - 1), start);
-    int file, line;
+    int line;
     const char *rest;
-    if (parse_location(first, &file, &line, &rest)) {
+    if (parse_location(first, &line, &rest)) {
         const char *fname = stage_name;
         char buf[300];
+        int file = line / RS_SHADER_LINE_BASE - 1;
         if (file >= 0 && file < rs_shader_source_count) {
             snprintf(buf, sizeof buf, "shaders_es/%s", rs_shader_sources[file].name);
             fname = buf;
         }
+        line %= RS_SHADER_LINE_BASE;
         while (*rest == ' ') rest++;
         snprintf(out, out_len, "%s:%d: %s", fname, line, rest);
     } else {
@@ -87,7 +88,8 @@ static rs_result compile(GLenum type, const char *name, const char *text, const 
     char line_reset[48] = "";
     // Inline sources carry no #line markers: renumber so errors point at the caller's own lines.
     if (!rs_shader_find(name) || rs_shader_find(name) != text)
-        snprintf(line_reset, sizeof line_reset, "#line %d %d\n", body == text ? 1 : 2, RS_SHADER_INLINE_FILE);
+        snprintf(line_reset, sizeof line_reset, "#line %d\n",
+                 (RS_SHADER_INLINE_FILE + 1) * RS_SHADER_LINE_BASE + (body == text ? 1 : 2));
     const char *parts[4] = {version, defines ? defines : "", line_reset, body};
 
     GLuint sh = glCreateShader(type);

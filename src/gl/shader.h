@@ -22,7 +22,11 @@ typedef struct rs_shader_source {
     const char *text;  // with includes expanded and #line markers
 } rs_shader_source;
 
-// Generated table (build/gen/shaders.c); the index of an entry is its #line file number.
+// Embedded sources number their lines (file_index + 1) * RS_SHADER_LINE_BASE + line, so a driver's
+// "0:LINE" names the file too.
+#define RS_SHADER_LINE_BASE 10000
+
+// Generated table (build/gen/shaders.c).
 extern const rs_shader_source rs_shader_sources[];
 extern const int rs_shader_source_count;
 

@@ -1,0 +1,234 @@
+#!/bin/sh
+# test_viewer.sh — the real viewer window under Xvfb: a stroke painted through the app (an event script
+# replayed through the same input queue the mouse feeds, and a real X mouse stroke from xdotool)
+# changes the painted area and nothing else; undo restores the picture exactly; a bad face file exits
+# with one clear line; a bad file dropped on the window leaves the face as it was.
+# Usage: sh tests/test_viewer.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
+# RS_TEST_FACE overrides the face (default assets/face.rsf).
+build=${1:-build}
+[ $# -gt 0 ] && shift
+filters="$*"
+rouge="$build/rouge"
+imgdiff="$build/rouge-imgdiff"
+face=${RS_TEST_FACE:-assets/face.rsf}
+out="${RS_TEST_OUT:-$build/test-out}/viewer"
+mkdir -p "$out"
+rm -f "$out"/*.png "$out"/*.events "$out"/*.flag 2>/dev/null
+
+selected() {
+    [ -z "$filters" ] && return 0
+    for f in $filters; do
+        case "$1" in *"$f"*) return 0 ;; esac
+    done
+    return 1
+}
+
+tests="viewer_script_stroke_changes_only_the_painted_area viewer_undo_restores_the_picture_exactly
+viewer_look_saved_and_loaded_renders_the_same viewer_records_a_replayable_stroke_file
+viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_one_line
+viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face"
+skip_all() {
+    for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
+    exit 0
+}
+command -v Xvfb >/dev/null 2>&1 || skip_all "Xvfb not installed (make deps)"
+[ -f "$face" ] || skip_all "no $face (set RS_TEST_FACE or build the bundled face)"
+[ -x "$rouge" ] && [ -x "$imgdiff" ] || skip_all "$rouge or $imgdiff not built"
+"$rouge" --help 2>/dev/null | grep -q -- "--events" || skip_all "$rouge has no --events option"
+
+# A free display number: no lock file and no socket.
+d=91
+while [ -e "/tmp/.X$d-lock" ] || [ -e "/tmp/.X11-unix/X$d" ]; do d=$((d + 1)); done
+Xvfb ":$d" -screen 0 1024x768x24 -nolisten tcp >"$out/xvfb.log" 2>&1 &
+xvfb=$!
+trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null' EXIT INT TERM
+i=0
+while [ ! -e "/tmp/.X11-unix/X$d" ] && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
+[ -e "/tmp/.X11-unix/X$d" ] || skip_all "Xvfb :$d did not start ($(head -c 200 "$out/xvfb.log"))"
+export DISPLAY=":$d" LIBGL_ALWAYS_SOFTWARE=1
+
+# The window is 800x600 at (0, 0) (no window manager). The face's forehead lies around (400, 150) at the
+# default camera; the toolbar covers the edges, so comparisons stay inside the free middle.
+# In: a box around the stroke. Out: three boxes around it that the brush cannot reach.
+IN="330 105 140 90"
+OUT1="80 260 630 150"
+OUT2="80 80 220 170"
+OUT3="500 80 210 170"
+view() {
+    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 "$@"
+}
+
+# shots PREFIX: screenshot commands for the in/out regions (the pointer parked on the swatch sheet, so
+# the brush ring is not drawn).
+shots() {
+    echo "move 400 580"
+    echo "idle"
+    echo "screenshot $out/$1_in.png $IN"
+    echo "screenshot $out/$1_out1.png $OUT1"
+    echo "screenshot $out/$1_out2.png $OUT2"
+    echo "screenshot $out/$1_out3.png $OUT3"
+    echo "screenshot $out/$1_mid.png 80 80 630 330"
+}
+
+# changed NAME A B: the in-box changed (more than 2% of its pixels by more than 8 levels).
+# same NAME A B...: the regions are identical within 2 levels on every pixel.
+region_changed() {
+    r=$("$imgdiff" "$out/$1_in.png" "$out/$2_in.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
+    awk -v f="$r" 'BEGIN { exit !(f != "" && f > 0.02) }'
+}
+region_same() {
+    a=$1 b=$2
+    shift 2
+    for reg in "$@"; do
+        m=$("$imgdiff" "$out/${a}_$reg.png" "$out/${b}_$reg.png" 2>&1 | awk '/^max_abs/ {print $2}')
+        [ -n "$m" ] && [ "$m" -le 2 ] || { echo "$reg max_abs=${m:-error}"; return 1; }
+    done
+    return 0
+}
+
+check_stroke() {
+    name=$1 a=$2 b=$3
+    if [ ! -f "$out/${b}_out3.png" ]; then
+        echo "FAIL - $name: no screenshots (see $out/$name.log): $(tail -c 300 "$out/$name.log")"
+    elif ! region_changed "$a" "$b"; then
+        echo "FAIL - $name: the stroke's area did not change (frac_over $r; $out/${a}_in.png vs ${b}_in.png)"
+    elif ! why=$(region_same "$a" "$b" out1 out2 out3); then
+        echo "FAIL - $name: outside the stroke changed: $why ($out)"
+    else
+        echo "ok - $name"
+    fi
+}
+
+if selected viewer_script_stroke_changes_only_the_painted_area || selected viewer_undo_restores_the_picture_exactly ||
+    selected viewer_look_saved_and_loaded_renders_the_same || selected viewer_records_a_replayable_stroke_file; then
+    rm -f "$out/test.look" "$out/rec.strokes"
+    {
+        echo "key i"          # HUD off: its numbers change from frame to frame
+        shots before
+        echo "key p"          # paint mode
+        echo "key 9"          # a strong colour (lipstick) so the change is unmistakable
+        echo "drag 370 150 430 150 30"
+        shots after
+        echo "key ctrl+z"
+        shots undone
+        echo "key ctrl+y"     # redo, then save the look, clear everything and load it back
+        echo "key ctrl+s"
+        echo "key delete"
+        echo "key ctrl+o"
+        shots reloaded
+        echo "quit"
+    } >"$out/stroke.events"
+    view --events "$out/stroke.events" --look "$out/test.look" --record "$out/rec.strokes" >"$out/script.log" 2>&1
+    rc=$?
+    if selected viewer_script_stroke_changes_only_the_painted_area; then
+        if [ $rc -ne 0 ]; then echo "FAIL - viewer_script_stroke_changes_only_the_painted_area: exit $rc: $(tail -c 300 "$out/script.log")"
+        else cp "$out/script.log" "$out/viewer_script_stroke_changes_only_the_painted_area.log"
+            check_stroke viewer_script_stroke_changes_only_the_painted_area before after; fi
+    fi
+    if selected viewer_undo_restores_the_picture_exactly; then
+        if [ ! -f "$out/undone_mid.png" ]; then echo "FAIL - viewer_undo_restores_the_picture_exactly: no screenshot (exit $rc)"
+        elif why=$(region_same before undone mid); then echo "ok - viewer_undo_restores_the_picture_exactly"
+        else echo "FAIL - viewer_undo_restores_the_picture_exactly: $why ($out/before_mid.png vs undone_mid.png)"; fi
+    fi
+    if selected viewer_look_saved_and_loaded_renders_the_same; then
+        name=viewer_look_saved_and_loaded_renders_the_same
+        if [ ! -s "$out/test.look" ]; then echo "FAIL - $name: no look file written (exit $rc)"
+        elif [ ! -f "$out/reloaded_mid.png" ]; then echo "FAIL - $name: no screenshot (exit $rc)"
+        elif why=$(region_same after reloaded mid); then echo "ok - $name"
+        else echo "FAIL - $name: $why ($out/after_mid.png vs reloaded_mid.png)"; fi
+    fi
+    if selected viewer_records_a_replayable_stroke_file; then
+        name=viewer_records_a_replayable_stroke_file
+        if ! head -1 "$out/rec.strokes" 2>/dev/null | grep -q "^rouge-strokes 1"; then
+            echo "FAIL - $name: $out/rec.strokes missing or not a stroke file"
+        elif ! timeout 120 "$rouge" render "$face" --strokes "$out/rec.strokes" --max-splats 100000 --pipeline mobile \
+            -o "$out/replayed.png" >"$out/replay.log" 2>&1; then
+            echo "FAIL - $name: replay failed: $(tail -c 300 "$out/replay.log")"
+        else echo "ok - $name"; fi
+    fi
+fi
+
+if selected viewer_xdotool_stroke_changes_only_the_painted_area; then
+    name=viewer_xdotool_stroke_changes_only_the_painted_area
+    if ! command -v xdotool >/dev/null 2>&1; then
+        echo "skip - $name: xdotool not installed"
+    else
+        flag="$out/xdo_done.flag"
+        {
+            echo "key i"
+            shots xbefore
+            echo "key p"
+            echo "key 9"
+            echo "wait-for $flag"
+            shots xafter
+            echo "quit"
+        } >"$out/xdo.events"
+        view --events "$out/xdo.events" >"$out/$name.log" 2>&1 &
+        pid=$!
+        # Wait for the first screenshots (the face is loaded and idle), then stroke with the real X pointer.
+        i=0
+        while [ ! -f "$out/xbefore_mid.png" ] && [ $i -lt 1200 ] && kill -0 $pid 2>/dev/null; do sleep 0.1; i=$((i + 1)); done
+        # A little longer: the script's next commands (paint mode, lipstick) run in the next frames.
+        sleep 1
+        xdotool mousemove 370 150 mousedown 1 >/dev/null 2>&1
+        x=370
+        while [ $x -lt 430 ]; do
+            x=$((x + 4))
+            xdotool mousemove $x 150 >/dev/null 2>&1
+            sleep 0.02
+        done
+        xdotool mouseup 1 mousemove 400 580 >/dev/null 2>&1
+        sleep 0.5
+        touch "$flag"
+        wait $pid
+        rc=$?
+        if [ $rc -ne 0 ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/$name.log")"
+        else check_stroke "$name" xbefore xafter; fi
+    fi
+fi
+
+if selected viewer_bad_face_exits_with_one_line; then
+    name=viewer_bad_face_exits_with_one_line
+    head -c 1000 "$face" >"$out/trunc.rsf"
+    timeout 60 "$rouge" view "$out/trunc.rsf" --size 320x240 >"$out/bad.out" 2>"$out/bad.err"
+    rc=$?
+    lines=$(wc -l <"$out/bad.err")
+    if [ $rc -ne 1 ]; then echo "FAIL - $name: exit $rc, wanted 1: $(head -c 300 "$out/bad.err")"
+    elif [ "$lines" -ne 1 ] || ! grep -q "^rouge: .*trunc.rsf" "$out/bad.err"; then
+        echo "FAIL - $name: wanted one 'rouge: ...trunc.rsf...' line, got: $(head -c 300 "$out/bad.err")"
+    else echo "ok - $name"; fi
+fi
+
+if selected viewer_bad_event_script_names_the_line; then
+    name=viewer_bad_event_script_names_the_line
+    printf 'move 10 10\nidle\njump 3\n' >"$out/bad.events"
+    timeout 60 "$rouge" view "$face" --events "$out/bad.events" >"$out/badev.out" 2>"$out/badev.err"
+    rc=$?
+    if [ $rc -eq 0 ] || ! grep -q "bad.events:3: unknown command 'jump'" "$out/badev.err" || [ "$(wc -l <"$out/badev.err")" -ne 1 ]; then
+        echo "FAIL - $name: exit $rc: $(head -c 300 "$out/badev.err")"
+    else echo "ok - $name"; fi
+fi
+
+if selected viewer_bad_dropped_file_keeps_the_face; then
+    name=viewer_bad_dropped_file_keeps_the_face
+    head -c 1000 "$face" >"$out/dropped.rsf"
+    {
+        echo "key i"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $out/dbefore_face.png 80 80 630 180"
+        echo "drop $out/dropped.rsf"
+        echo "wait 1.5"
+        echo "idle"
+        echo "screenshot $out/dafter_face.png 80 80 630 180"
+        echo "screenshot $out/dafter_all.png"
+        echo "quit"
+    } >"$out/drop.events"
+    view --events "$out/drop.events" >"$out/drop.log" 2>&1
+    rc=$?
+    if [ $rc -ne 0 ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/drop.log")"
+    elif [ ! -f "$out/dafter_face.png" ]; then echo "FAIL - $name: no screenshot"
+    elif why=$(region_same dbefore dafter face); then echo "ok - $name"
+    else echo "FAIL - $name: the face changed after a bad drop: $why"; fi
+fi
+exit 0
