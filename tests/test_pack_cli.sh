@@ -1,0 +1,87 @@
+#!/bin/sh
+# CLI behaviour of `rouge-pack`: conversions and --info work; bad input gets one "rouge-pack: ..." line,
+# exit 2 for usage and 1 for failures, and no output file (nor a temp file) left behind.
+build=${1:-build}
+pack="$build/rouge-pack"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fx=tests/fixtures/ply
+
+if [ ! -x "$pack" ]; then echo "FAIL - pack_cli: $pack not built"; exit 1; fi
+
+# expect NAME WANT_RC PATTERN CMD... : runs CMD, checks the exit code and a one-line stderr matching PATTERN.
+expect() {
+    name=$1; want=$2; pat=$3; shift 3
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    rc=$?
+    lines=$(wc -l <"$tmp/err")
+    if [ "$rc" -ne "$want" ]; then
+        echo "FAIL - $name: exit $rc, wanted $want: $(head -c 300 "$tmp/err")"
+    elif [ -n "$pat" ] && ! grep -q -- "$pat" "$tmp/err"; then
+        echo "FAIL - $name: stderr lacks '$pat': $(head -c 300 "$tmp/err")"
+    elif [ "$want" -ne 0 ] && { [ "$lines" -ne 1 ] || ! grep -q '^rouge-pack: ' "$tmp/err"; }; then
+        echo "FAIL - $name: error is not one 'rouge-pack:' line: $(head -c 300 "$tmp/err")"
+    else
+        echo "ok - $name"
+    fi
+}
+no_file() {
+    if [ -e "$2" ] || ls "$2".tmp* >/dev/null 2>&1; then echo "FAIL - $1: left $2 behind"; else echo "ok - $1"; fi
+}
+has() {  # has NAME FILE PATTERN
+    if grep -q -- "$3" "$2"; then echo "ok - $1"; else echo "FAIL - $1: '$3' not in: $(head -c 300 "$2")"; fi
+}
+
+expect pack_help_exits_zero 0 "" "$pack" --help
+has pack_help_states_assumptions "$tmp/out" "front-facing head"
+expect pack_no_input 2 "no input" "$pack"
+expect pack_unknown_flag 2 "unknown option '--frobnicate'" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --frobnicate
+expect pack_missing_value 2 "--points needs a value" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --points
+expect pack_bad_number 2 "--points: expected a count" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --points 12abc
+expect pack_zero_points 2 "--points" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --points 0
+expect pack_bad_mm 2 "--mm-per-unit" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --mm-per-unit -3
+expect pack_bad_axis 2 "--up: expected an axis" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --up sideways
+expect pack_parallel_axes 2 "different axes" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --up +z --forward -z
+expect pack_two_inputs 2 "more than one input" "$pack" "$fx/points_le.ply" "$fx/points_be.ply" -o "$tmp/a.rsf"
+expect pack_no_output 2 "no output" "$pack" "$fx/points_le.ply"
+no_file pack_usage_errors_leave_no_output "$tmp/a.rsf"
+
+expect pack_missing_input 1 "cannot open" "$pack" "$tmp/none.ply" -o "$tmp/b.rsf"
+no_file pack_missing_input_leaves_no_output "$tmp/b.rsf"
+expect pack_malformed_input 1 "bad_truncated.ply" "$pack" "$fx/bad_truncated.ply" -o "$tmp/c.rsf"
+no_file pack_malformed_input_leaves_no_output "$tmp/c.rsf"
+expect pack_huge_count 1 "" "$pack" "$fx/bad_huge_count.ply" -o "$tmp/c.rsf"
+no_file pack_huge_count_leaves_no_output "$tmp/c.rsf"
+expect pack_unwritable_output 1 "cannot write" "$pack" "$fx/points_le.ply" -o "$tmp/no/such/dir/d.rsf"
+mkdir "$tmp/dir.rsf"
+expect pack_directory_as_output 1 "dir.rsf" "$pack" "$fx/points_le.ply" -o "$tmp/dir.rsf"
+if ls "$tmp"/dir.rsf.tmp* >/dev/null 2>&1; then echo "FAIL - pack_directory_as_output_leaves_no_temp: $(ls "$tmp")"; else echo "ok - pack_directory_as_output_leaves_no_temp"; fi
+expect pack_missing_texture 1 "--texture" "$pack" "$fx/mesh_st.ply" -o "$tmp/e.rsf" --texture "$tmp/none.png"
+no_file pack_missing_texture_leaves_no_output "$tmp/e.rsf"
+expect pack_texture_without_uv 1 "texture coordinates" "$pack" "$fx/points_le.ply" -o "$tmp/e.rsf" --texture tests/fixtures/image/a_8x8.png
+no_file pack_texture_without_uv_leaves_no_output "$tmp/e.rsf"
+expect pack_bad_region_property 1 "region 7" "$pack" "$fx/points_region.ply" -o "$tmp/e.rsf"
+no_file pack_bad_region_property_leaves_no_output "$tmp/e.rsf"
+
+# Conversions: a 4-point cloud (16 bytes per splat after the header), a textured mesh, the summary.
+expect pack_converts_cloud 0 "" "$pack" "$fx/points_le.ply" -o "$tmp/f.rsf"
+has pack_summary_reports_size "$tmp/out" "bytes/splat"
+expect pack_converts_textured_mesh 0 "" "$pack" "$fx/mesh_st.ply" -o "$tmp/g.rsf" --points 2000 \
+    --texture tests/fixtures/image/a_8x8.png --normal-map tests/fixtures/image/c_4x4.png \
+    --specular-map tests/fixtures/image/c_4x4.png --region-map tests/fixtures/image/a_8x8.png --preview "$tmp/g.png"
+if [ -s "$tmp/g.png" ]; then echo "ok - pack_writes_preview"; else echo "FAIL - pack_writes_preview: no PNG"; fi
+has pack_summary_measures_specular_map "$tmp/out" "specular map"
+expect pack_quiet_prints_nothing 0 "" "$pack" "$fx/points_ascii.ply" -o "$tmp/h.rsf" -q
+if [ -s "$tmp/out" ]; then echo "FAIL - pack_quiet_stdout_empty: $(head -c 200 "$tmp/out")"; else echo "ok - pack_quiet_stdout_empty"; fi
+a=$(wc -c <"$tmp/f.rsf"); b=$(wc -c <"$tmp/h.rsf")
+if [ "$a" -eq "$b" ]; then echo "ok - pack_same_cloud_same_size"; else echo "FAIL - pack_same_cloud_same_size: $a vs $b"; fi
+
+expect pack_info 0 "" "$pack" --info "$tmp/g.rsf"
+has pack_info_lists_lods "$tmp/out" "LOD prefixes"
+has pack_info_lists_regions "$tmp/out" "rho_s"
+has pack_info_lists_notes "$tmp/out" "converted by rouge-pack"
+head -c 300 "$tmp/g.rsf" >"$tmp/trunc.rsf"
+expect pack_info_truncated 1 "trunc.rsf" "$pack" --info "$tmp/trunc.rsf"
+expect pack_info_missing 1 "cannot open" "$pack" --info "$tmp/none.rsf"
+expect pack_info_with_input 2 "--info" "$pack" --info "$tmp/g.rsf" "$fx/points_le.ply"
+exit 0

@@ -1,0 +1,368 @@
+// rouge_pack.c — rouge-pack: converts a PLY scan (point cloud or textured mesh) into an .rsf splat file,
+// and prints what an .rsf holds (see tools/pack.h for the steps, docs/rsf.md for the format).
+//
+// Exit status: 0 done, 1 the conversion or a file failed, 2 usage. Errors are one "rouge-pack: ..." line
+// on stderr; a progress bar goes to stderr only when it is a terminal; the summary goes to stdout.
+#define _POSIX_C_SOURCE 200809L
+#include "pack.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+static const char usage[] =
+    "usage: rouge-pack INPUT.ply -o OUT.rsf [options]\n"
+    "       rouge-pack --info FILE.rsf [--preview PNG]\n"
+    "\n"
+    "Converts a PLY scan into rouge's compact splat file (.rsf, 16 bytes per splat): normals (estimated\n"
+    "by k-nearest-neighbour PCA when the PLY has none), a radius per splat from the local spacing, LOD\n"
+    "order (every prefix in the LOD table is an even subsample), and face regions for the skin BRDF.\n"
+    "\n"
+    "Input: ASCII or binary PLY; a point cloud is used as it is, a mesh (faces) is sampled area-uniformly.\n"
+    "  --points N          mesh: number of splats to sample (default 600000); cloud: decimate to N\n"
+    "                      (a Poisson-disk-like subset); default keeps every point\n"
+    "  --texture PNG       sRGB colour map, sampled bilinearly at (s, 1 - t): t = 0 is the bottom row\n"
+    "  --normal-map PNG    tangent-space normal map (OpenGL convention, +G along +t); mesh only\n"
+    "  --specular-map PNG  specular-intensity map: measured per region and printed in the summary only;\n"
+    "                      the .rsf keeps per-region m and rho_s (Weyrich et al. means), not per splat\n"
+    "  --region-map PNG    region ids in UV space: black other, red cheek, green nose, blue forehead,\n"
+    "                      yellow lips, white = automatic. A per-vertex `region` PLY property (0 other,\n"
+    "                      1 cheek, 2 nose, 3 forehead, 4 lips) is used the same way\n"
+    "  --all-components    mesh: sample every connected component; by default only the largest (by\n"
+    "                      area) is kept, which on a scan is the skin, not caps or mouth/eye pockets\n"
+    "  Inputs without colour get a light warm grey (sRGB 200 178 160).\n"
+    "\n"
+    "Face (assumed: one upright, front-facing head; the nose is the sharpest forward bump of the face):\n"
+    "  --up AXIS           +x -x +y -y +z -z (default +y)\n"
+    "  --forward AXIS      the direction the face looks (default +z)\n"
+    "  --mm-per-unit X     physical scale; default: estimated from the head height (vertex to chin)\n"
+    "                      taken as 225 mm. The bundled head is about 47 mm per unit\n"
+    "\n"
+    "Output:\n"
+    "  -o, --output FILE   the .rsf to write (atomically: no file is left on failure)\n"
+    "  --min-lod N         smallest LOD prefix listed (default 10000)\n"
+    "  --seed S            random seed for sampling (default 20240600); same seed, same file\n"
+    "  --preview PNG       also write a CPU preview: front colour, front regions, side regions\n"
+    "  -q, --quiet         no progress bar, no summary\n"
+    "  --info FILE.rsf     print counts, bytes per splat, LOD and region tables, frame and notes\n"
+    "  -h, --help          this text\n"
+    "\n"
+    "Exit status: 0 done, 1 conversion or file error, 2 usage.\n";
+
+static int fail(int code, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int fail(int code, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("rouge-pack: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+    return code;
+}
+
+// Parses all of s as an integer in [lo, hi].
+static bool parse_u64(const char *s, uint64_t lo, uint64_t hi, uint64_t *out)
+{
+    char *end;
+    errno = 0;
+    if (!s[0] || s[0] == '-') return false;
+    unsigned long long v = strtoull(s, &end, 10);
+    if (*end || errno || v < lo || v > hi) return false;
+    *out = v;
+    return true;
+}
+
+static bool parse_float(const char *s, float *out)
+{
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v) || !(v > 0) || v > 1e30) return false;
+    *out = (float)v;
+    return true;
+}
+
+static long long file_size(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (long long)st.st_size : -1;
+}
+
+// ---- progress bar (stderr, terminals only) ----
+
+typedef struct progress {
+    bool on;
+    int last_step, last_pct;
+} progress;
+
+static void show_progress(void *user, rs_pack_step step, double f)
+{
+    progress *p = user;
+    int pct = (int)(RS_CLAMP(f, 0.0, 1.0) * 100.0);
+    if ((int)step == p->last_step && pct == p->last_pct) return;
+    p->last_step = (int)step;
+    p->last_pct = pct;
+    char bar[31];
+    int full = pct * 30 / 100;
+    for (int i = 0; i < 30; i++) bar[i] = i < full ? '#' : '.';
+    bar[30] = 0;
+    fprintf(stderr, "\r  %-10s [%s] %3d%%", rs_pack_step_name(step), bar, pct);
+    if (step == RS_PACK_STEP_ENCODE && pct == 100) fputs("\r\033[K", stderr);
+    fflush(stderr);
+}
+
+// ---- --info ----
+
+static int info(const char *path, const char *preview)
+{
+    rs_error err = {0};
+    rs_splat_cloud *c = NULL;
+    if (rs_splat_load(path, &c, &err) != RS_OK) return fail(1, "%s", err.msg);
+    const rs_splat_header *h = &c->hdr;
+    long long size = file_size(path);
+    printf("%s\n", path);
+    printf("  splats        %u\n", h->count);
+    printf("  file size     %lld bytes (%.2f bytes/splat)\n", size, h->count ? (double)size / h->count : 0.0);
+    printf("  bbox          (%.4f %.4f %.4f) .. (%.4f %.4f %.4f) units\n", h->bbox_min[0], h->bbox_min[1],
+           h->bbox_min[2], h->bbox_max[0], h->bbox_max[1], h->bbox_max[2]);
+    printf("  radius        %.5f .. %.5f units (%.3f .. %.3f mm)\n", h->radius_min, h->radius_max,
+           h->radius_min * h->mm_per_unit, h->radius_max * h->mm_per_unit);
+    printf("  mm_per_unit   %.3f\n", h->mm_per_unit);
+    printf("  face height   %.4f units (%.1f mm)\n", h->face_height, h->face_height * h->mm_per_unit);
+    printf("  centre        (%.4f %.4f %.4f)\n", h->centre[0], h->centre[1], h->centre[2]);
+    printf("  forward       (%.4f %.4f %.4f)\n", h->forward[0], h->forward[1], h->forward[2]);
+    printf("  up            (%.4f %.4f %.4f)\n", h->up[0], h->up[1], h->up[2]);
+    printf("  LOD prefixes  %u\n", h->lod_count);
+    for (uint32_t i = 0; i < h->lod_count; i++)
+        printf("    %2u  %9u splats  %6.2f%%  radius x %.3f\n", i, h->lods[i], 100.0 * h->lods[i] / h->count,
+               rs_splat_lod_radius_scale(c, h->lods[i]));
+    printf("  regions       %u\n", h->region_count);
+    for (uint32_t i = 0; i < h->region_count; i++)
+        printf("    %2u  %-10s m %.4f  rho_s %.4f  %9u splats (%5.2f%%)\n", i, h->regions[i].name, h->regions[i].m,
+               h->regions[i].rho_s, c->region_counts[i], 100.0 * c->region_counts[i] / h->count);
+    printf("  notes\n");
+    const char *s = h->notes;
+    while (*s) {
+        const char *e = strchr(s, '\n');
+        int len = e ? (int)(e - s) : (int)strlen(s);
+        printf("    %.*s\n", len, s);
+        s += len + (e ? 1 : 0);
+    }
+    int rc = 0;
+    if (preview) {
+        rs_image img = {0};
+        if (rs_pack_preview(c, 512, &img, &err) != RS_OK || rs_image_write_png(preview, &img, &err) != RS_OK)
+            rc = fail(1, "%s", err.msg);
+        rs_image_free(&img);
+    }
+    rs_splat_destroy(c);
+    return rc;
+}
+
+// ---- conversion ----
+
+typedef struct options {
+    const char *input, *output, *preview;
+    char texture_hint[256];  // the mesh's "TextureFile" comment when --texture was not given
+    const char *maps[4];  // texture, normal, specular, region
+    rs_pack_desc desc;
+    bool quiet;
+} options;
+
+static const char *const map_flag[4] = {"--texture", "--normal-map", "--specular-map", "--region-map"};
+
+static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pack_report *rep, double load_s,
+                          double save_s)
+{
+    const rs_pack_face *f = &rep->face;
+    long long in_size = file_size(o->input), out_size = file_size(o->output);
+    printf("rouge-pack: %s -> %s\n", o->input, o->output);
+    if (rep->sampled_mesh)
+        printf("  input         mesh, %u vertices, %u triangles (%u outside the largest component, skipped)\n",
+               rep->input_vertices, rep->input_triangles, rep->triangles_dropped);
+    else
+        printf("  input         point cloud, %u points%s\n", rep->input_vertices,
+               rep->duplicates_dropped ? " (duplicates dropped)" : "");
+    if (rep->duplicates_dropped) printf("  duplicates    %u points at the same position dropped\n", rep->duplicates_dropped);
+    printf("  splats        %u%s\n", rep->splats, rep->sampled_mesh ? " (area-uniform samples)" : "");
+    printf("  normals       %s\n", rep->normals_estimated ? "estimated (16-NN PCA, MST orientation)" : "from the input");
+    printf("  colour        %s\n", rep->colour_default ? "none in the input: light warm grey (sRGB 200 178 160)"
+                                                        : (o->maps[0] ? "from the texture" : "from the input"));
+    if (o->texture_hint[0])
+        printf("  note          the PLY names the texture '%s'; pass --texture to colour from it\n", o->texture_hint);
+    printf("  size          %lld bytes = %.2f bytes/splat (input PLY: %lld bytes = %.2f bytes/%s)\n", out_size,
+           (double)out_size / c->hdr.count, in_size, (double)in_size / (rep->input_vertices ? rep->input_vertices : 1),
+           rep->sampled_mesh ? "vertex" : "point");
+    printf("  LOD           %u prefix%s:", c->hdr.lod_count, c->hdr.lod_count == 1 ? "" : "es");
+    for (uint32_t i = 0; i < c->hdr.lod_count; i++) printf(" %u", c->hdr.lods[i]);
+    printf("\n");
+    if (f->found) {
+        printf("  face          nose tip (%.3f %.3f %.3f), mouth (%.3f %.3f %.3f), height %.3f units\n", f->nose_tip[0],
+               f->nose_tip[1], f->nose_tip[2], f->mouth[0], f->mouth[1], f->mouth[2], f->face_height);
+    } else {
+        printf("  face          not found: every splat is `other` (see --help for the assumptions)\n");
+    }
+    printf("  mm_per_unit   %.3f%s\n", c->hdr.mm_per_unit,
+           rep->mm_estimated ? " (estimated: head height taken as 225 mm; set --mm-per-unit if known)" : "");
+    printf("  regions      ");
+    for (uint32_t i = 0; i < c->hdr.region_count; i++)
+        printf(" %s %.1f%%", c->hdr.regions[i].name, 100.0 * c->region_counts[i] / c->hdr.count);
+    printf("%s\n", rep->regions_given ? " (some given by the input)" : "");
+    if (o->maps[2]) {
+        printf("  specular map  mean per region (not stored):");
+        for (uint32_t i = 0; i < RS_REGION_BUILTIN_COUNT; i++)
+            if (!isnan(rep->specular_mean[i])) printf(" %s %.3f", c->hdr.regions[i].name, rep->specular_mean[i]);
+        printf("\n");
+    }
+    double total = load_s + save_s;
+    printf("  time          load %.2fs", load_s);
+    for (int s = 0; s < RS_PACK_STEP_COUNT; s++) {
+        if (rep->seconds[s] == 0) continue;
+        printf(", %s %.2fs", rs_pack_step_name((rs_pack_step)s), rep->seconds[s]);
+        total += rep->seconds[s];
+    }
+    printf(", save %.2fs; total %.2fs\n", save_s, total);
+}
+
+static int convert(options *o)
+{
+    rs_error err = {0};
+    // Fail before the slow part when the output cannot be written at all.
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", o->output);
+    char *slash = strrchr(dir, '/');
+    if (slash) *(slash == dir ? slash + 1 : slash) = 0;
+    else snprintf(dir, sizeof dir, ".");
+    if (access(dir, W_OK) != 0) return fail(1, "%s: cannot write: %s", o->output, strerror(errno));
+
+    double t0 = rs_time_now();
+    rs_ply_mesh *mesh = NULL;
+    if (rs_ply_load(o->input, &mesh, &err) != RS_OK) return fail(1, "%s", err.msg);
+    rs_image img[4] = {{0}};
+    const rs_image **slot[4] = {&o->desc.texture, &o->desc.normal_map, &o->desc.specular_map, &o->desc.region_map};
+    for (int k = 0; k < 4; k++) {
+        if (!o->maps[k]) continue;
+        if (rs_image_read_png(o->maps[k], &img[k], &err) != RS_OK) {
+            for (int j = 0; j < k; j++) rs_image_free(&img[j]);
+            rs_ply_destroy(mesh);
+            return fail(1, "%s: %s", map_flag[k], err.msg);
+        }
+        *slot[k] = &img[k];
+    }
+    double load_s = rs_time_now() - t0;
+
+    char notes[512];
+    const char *base = strrchr(o->input, '/');
+    snprintf(notes, sizeof notes, "converted by rouge-pack from %s", base ? base + 1 : o->input);
+    o->desc.notes = notes;
+    progress bar = {.on = !o->quiet && isatty(2), .last_step = -1, .last_pct = -1};
+    if (bar.on) {
+        o->desc.progress = show_progress;
+        o->desc.progress_user = &bar;
+    }
+    if (mesh->texture_file && mesh->tri && !o->maps[0])
+        snprintf(o->texture_hint, sizeof o->texture_hint, "%s", mesh->texture_file);
+    rs_pack_report rep;
+    rs_splat_cloud *cloud = NULL;
+    rs_result r = rs_pack_convert(mesh, &o->desc, &cloud, &rep, &err);
+    if (bar.on) fputs("\r\033[K", stderr);
+    for (int k = 0; k < 4; k++) rs_image_free(&img[k]);
+    rs_ply_destroy(mesh);
+    if (r != RS_OK) return fail(1, "%s: %s", o->input, err.msg);
+
+    // The preview is drawn before anything is written, so a failure leaves no files behind.
+    rs_image pv = {0};
+    if (o->preview && rs_pack_preview(cloud, 512, &pv, &err) != RS_OK) {
+        rs_splat_destroy(cloud);
+        return fail(1, "preview: %s", err.msg);
+    }
+    double t1 = rs_time_now();
+    r = rs_splat_save(cloud, o->output, &err);
+    double save_s = rs_time_now() - t1;
+    if (r == RS_OK && o->preview && rs_image_write_png(o->preview, &pv, &err) != RS_OK) {
+        unlink(o->output);
+        r = err.code ? err.code : RS_ERR_IO;
+    }
+    rs_image_free(&pv);
+    if (r != RS_OK) {
+        rs_splat_destroy(cloud);
+        return fail(1, "%s", err.msg);
+    }
+    if (!o->quiet) print_summary(o, cloud, &rep, load_s, save_s);
+    rs_splat_destroy(cloud);
+    return 0;
+}
+
+int main(int argc, char **argv)
+{
+    options o = {0};
+    const char *info_path = NULL;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        // Flags that take a value: the value is the next argument.
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+        bool takes = true;
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            fputs(usage, stdout);
+            return 0;
+        } else if (!strcmp(a, "-q") || !strcmp(a, "--quiet")) {
+            o.quiet = true;
+            takes = false;
+        } else if (!strcmp(a, "--all-components")) {
+            o.desc.all_components = true;
+            takes = false;
+        } else if (a[0] == '-' && a[1] != 0) {
+            static const char *const known[] = {"-o", "--output", "--points", "--texture", "--normal-map",
+                                                "--specular-map", "--region-map", "--mm-per-unit", "--min-lod",
+                                                "--seed", "--up", "--forward", "--preview", "--info"};
+            bool ok = false;
+            for (size_t k = 0; k < RS_COUNT_OF(known); k++) ok |= !strcmp(a, known[k]);
+            if (!ok) return fail(2, "unknown option '%s' (see --help)", a);
+        } else {
+            if (o.input) return fail(2, "more than one input: '%s' and '%s'", o.input, a);
+            o.input = a;
+            takes = false;
+        }
+        if (!takes) continue;
+        if (!v) return fail(2, "%s needs a value", a);
+        i++;
+        uint64_t n;
+        if (!strcmp(a, "-o") || !strcmp(a, "--output")) o.output = v;
+        else if (!strcmp(a, "--preview")) o.preview = v;
+        else if (!strcmp(a, "--info")) info_path = v;
+        else if (!strcmp(a, "--points")) {
+            if (!parse_u64(v, 1, RS_SPLAT_MAX_COUNT, &n)) return fail(2, "--points: expected a count 1..%u, got '%s'", RS_SPLAT_MAX_COUNT, v);
+            o.desc.points = (uint32_t)n;
+        } else if (!strcmp(a, "--min-lod")) {
+            if (!parse_u64(v, 1, RS_SPLAT_MAX_COUNT, &n)) return fail(2, "--min-lod: expected a count 1..%u, got '%s'", RS_SPLAT_MAX_COUNT, v);
+            o.desc.min_lod = (uint32_t)n;
+        } else if (!strcmp(a, "--seed")) {
+            if (!parse_u64(v, 0, UINT64_MAX, &n)) return fail(2, "--seed: expected a non-negative integer, got '%s'", v);
+            o.desc.seed = n;
+        } else if (!strcmp(a, "--mm-per-unit")) {
+            if (!parse_float(v, &o.desc.mm_per_unit)) return fail(2, "--mm-per-unit: expected a number > 0, got '%s'", v);
+        } else if (!strcmp(a, "--up") || !strcmp(a, "--forward")) {
+            rs_pack_axis ax = rs_pack_axis_parse(v);
+            if (ax == RS_PACK_AXIS_DEFAULT) return fail(2, "%s: expected an axis +x -x +y -y +z -z, got '%s'", a, v);
+            *(a[2] == 'u' ? &o.desc.up : &o.desc.forward) = ax;
+        } else {
+            for (int k = 0; k < 4; k++)
+                if (!strcmp(a, map_flag[k])) o.maps[k] = v;
+        }
+    }
+    if (info_path) {
+        if (o.input || o.output) return fail(2, "--info takes only an .rsf file (and --preview)");
+        return info(info_path, o.preview);
+    }
+    if (!o.input) return fail(2, "no input PLY (see --help)");
+    rs_pack_axis up = o.desc.up ? o.desc.up : RS_PACK_AXIS_POS_Y, fwd = o.desc.forward ? o.desc.forward : RS_PACK_AXIS_POS_Z;
+    if ((up - 1) / 2 == (fwd - 1) / 2) return fail(2, "--up and --forward must be different axes");
+    if (!o.output) return fail(2, "no output: give -o OUT.rsf");
+    return convert(&o);
+}
