@@ -20,6 +20,7 @@
 #include "core.h"
 #include "gl/gl.h"
 #include "image.h"
+#include "makeup.h"
 #include "splat/splat.h"
 
 typedef enum rs_render_mode {
@@ -77,19 +78,32 @@ typedef struct rs_view {
     uint32_t max_splats;        // cap on the LOD prefix drawn (0: pipeline decides)
     int kernel_count;           // mobile pipeline: K Gaussians (0: default)
     rs_splat_prim prim;         // primitive choice (AUTO by caps)
+    float ambient;              // uniform sky irradiance added to every splat (linear, unshadowed); 0: none
+    bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)
 } rs_view;
 
-// Defaults: 512x512, frontal, zoom 1, fov 30, key light from upper left-front, fill off, full mode,
-// reference pipeline, exposure 1, dark grey background.
+// Defaults: 512x512, frontal, zoom 1, fov 30, key light from upper left-front (yaw -35, pitch 30), fill
+// off, ambient 0.05, full mode, reference pipeline, paper composite, exposure 1, dark grey background.
 rs_view rs_view_defaults(void);
 
 typedef struct rs_render_desc {
     const rs_splat_cloud *cloud;     // kept by pointer: must outlive the renderer
     const rs_gl_caps *caps;
     bool force_no_float_targets;     // test the RGBA8 fallback path on drivers that have float targets
+    bool time_stages;                // glFinish after each stage and time it (rs_render_stats.stage_ms)
 } rs_render_desc;
 
 typedef struct rs_renderer rs_renderer;
+
+// The paper's five stages (Fig. 2), for per-stage timings.
+typedef enum rs_render_stage {
+    RS_STAGE_SHADOW = 0,
+    RS_STAGE_VISIBILITY,
+    RS_STAGE_ATTRIBUTE,
+    RS_STAGE_DIFFUSION,
+    RS_STAGE_COMPOSITE,
+    RS_STAGE_COUNT
+} rs_render_stage;
 
 typedef struct rs_render_stats {
     uint32_t splats_drawn;           // main passes
@@ -98,6 +112,9 @@ typedef struct rs_render_stats {
     bool used_points;                // point sprites (true) or instanced quads (false)
     bool float_targets;
     size_t gpu_bytes;                // buffers + textures owned by the renderer
+    double stage_ms[RS_STAGE_COUNT]; // last frame, glFinish-timed (desc.time_stages); 0 otherwise
+    double frame_ms;                 // last frame's rs_render_frame wall time (glFinish-timed if time_stages)
+    double level_ms[6];              // stage 4 per drawn Gaussian level, same timing (kernel_count entries)
 } rs_render_stats;
 
 rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_error *err);
@@ -124,6 +141,10 @@ bool rs_render_project(const rs_renderer *r, const rs_view *view, const float po
 // Makeup layer records (rs_makeup_gpu, 8 bytes each) for splats [first, first + count).
 rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count, const void *records,
                                   rs_error *err);
+
+// The makeup shader's uniforms (rs_makeup_get_uniforms: the face's colour range the pigment is clamped
+// into). Call once after creating the makeup layer; until then the range is 0..1.
+void rs_render_set_makeup_uniforms(rs_renderer *r, const rs_makeup_uniforms *u);
 
 rs_render_stats rs_render_get_stats(const rs_renderer *r);
 

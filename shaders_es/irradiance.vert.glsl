@@ -1,0 +1,51 @@
+#version 300 es
+// irradiance.vert.glsl — stage 4's per-splat input, computed once per frame by transform feedback (no
+// rasterisation) so the diffusion levels don't repeat the shadow-map PCF: each splat's irradiance
+// E = key (N.L, shadow-mapped) + fill (N.L) + ambient, and how far it lies behind the visible surface when
+// it faces away (the back of the head: the levels skip it when that exceeds their kernel's reach).
+precision highp float;
+precision highp int;
+#include "splat_decode.glsl"
+#include "shadow_lookup.glsl"
+
+layout(location = 0) in uvec4 a_splat;
+uniform mat4 u_view;
+uniform mat4 u_proj;
+uniform mat4 u_inv_proj;
+uniform vec2 u_viewport;
+uniform vec3 u_key_dir;         // view space, towards the light
+uniform vec3 u_key_color;       // linear RGB * intensity
+uniform vec3 u_fill_dir;
+uniform vec3 u_fill_color;      // zero when the fill light is off
+uniform vec3 u_ambient;
+uniform highp sampler2D u_depth;  // visibility depth
+uniform float u_eps;
+
+out vec4 v_irradiance;          // (E, distance behind the visible surface; -1: faces the eye or in view)
+
+// How far view-space point c lies behind the visible surface at its own pixel; -1 when not behind it.
+float behind_visible(vec3 c)
+{
+    vec4 clip = u_proj * vec4(c, 1.0);
+    if (clip.w <= 0.0) return -1.0;
+    vec2 ndc = clip.xy / clip.w;
+    if (any(greaterThan(abs(ndc), vec2(1.0)))) return -1.0;
+    ivec2 px = clamp(ivec2((ndc * 0.5 + 0.5) * u_viewport), ivec2(0), ivec2(u_viewport) - 1);
+    float z = texelFetch(u_depth, px, 0).r;
+    if (z >= 1.0) return -1.0;
+    vec4 h = u_inv_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
+    return length(c) - (length(h.xyz / h.w) - u_eps);
+}
+
+void main()
+{
+    rs_splat s = rs_decode_splat(a_splat);
+    vec3 c = (u_view * vec4(s.pos, 1.0)).xyz;
+    vec3 n = mat3(u_view) * s.normal;
+    vec3 e = u_key_color * max(dot(n, u_key_dir), 0.0);
+    if (dot(e, e) > 0.0) e *= rs_shadow(c, n);
+    e += u_fill_color * max(dot(n, u_fill_dir), 0.0) + u_ambient;
+    v_irradiance = vec4(e, dot(n, -c) < 0.0 ? behind_visible(c) : -1.0);
+    gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
+    gl_PointSize = 1.0;
+}

@@ -1,0 +1,48 @@
+// splat_decode.glsl — the 16-byte splat record (src/splat/splat.h, docs/rsf.md) decoded exactly as
+// rs_splat_get does on the CPU, so picking, brushes and pixels agree.
+uniform vec3 u_bbox_min;      // quantization frame, model units
+uniform vec3 u_bbox_step;     // (bbox_max - bbox_min) / 65535
+uniform vec2 u_radius_log;    // radius = u_radius_log.x * exp(u_radius_log.y * q), q = 0..255
+
+struct rs_splat {
+    vec3 pos;       // model units
+    vec3 normal;    // unit, outward
+    float radius;   // model units (before the LOD scale)
+    vec3 albedo;    // linear RGB
+    uint region;
+};
+
+float rs_snorm16(uint bits)
+{
+    float s = float(bits & 0xffffu);
+    return max((s >= 32768.0 ? s - 65536.0 : s) / 32767.0, -1.0);
+}
+
+// Octahedral decode (Cigolle et al. 2014), the mirror of rs_splat_decode_normal.
+vec3 rs_decode_normal(uint code)
+{
+    vec2 e = vec2(rs_snorm16(code), rs_snorm16(code >> 16));
+    float z = 1.0 - abs(e.x) - abs(e.y);
+    if (z < 0.0) {
+        vec2 s = vec2(e.x < 0.0 ? -1.0 : 1.0, e.y < 0.0 ? -1.0 : 1.0);
+        e = (1.0 - abs(e.yx)) * s;
+    }
+    return normalize(vec3(e, z));
+}
+
+vec3 rs_srgb_to_linear(vec3 c)
+{
+    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+}
+
+rs_splat rs_decode_splat(uvec4 w)
+{
+    rs_splat s;
+    s.pos = u_bbox_min + vec3(float(w.x & 0xffffu), float(w.x >> 16), float(w.y & 0xffffu)) * u_bbox_step;
+    s.radius = u_radius_log.x * exp(u_radius_log.y * float((w.y >> 16) & 0xffu));
+    s.region = w.y >> 24;
+    s.normal = rs_decode_normal(w.z);
+    s.albedo = rs_srgb_to_linear(vec3(float(w.w & 0xffu), float((w.w >> 8) & 0xffu),
+                                      float((w.w >> 16) & 0xffu)) / 255.0);
+    return s;
+}

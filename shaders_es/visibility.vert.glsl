@@ -1,0 +1,41 @@
+#version 300 es
+// visibility.vert.glsl — stage 2, visibility splatting (Botsch et al. 2005): every splat as a disk in a
+// depth-only pass. The same program draws stage 1's shadow map (from the light, RS_SHADOW) and the ID
+// buffer for picking (RS_PICK). RS_QUADS: instanced quads instead of point sprites.
+precision highp float;
+precision highp int;
+#include "splat_decode.glsl"
+#include "splat_sprite.glsl"
+
+layout(location = 0) in uvec4 a_splat;
+uniform mat4 u_view;           // model -> view (the camera, or the light)
+uniform float u_radius_scale;  // LOD: sqrt(N / n)
+uniform float u_cull_cos;
+uniform float u_coverage;      // back-face culling: splats with dot(normal, to_eye) below this are dropped
+
+flat out vec3 v_c;
+flat out vec3 v_n;
+flat out float v_r;
+#ifdef RS_PICK
+flat out uint v_id;
+#endif
+
+void main()
+{
+    rs_splat s = rs_decode_splat(a_splat);
+    vec3 c = (u_view * vec4(s.pos, 1.0)).xyz;
+    vec3 n = mat3(u_view) * s.normal;
+    // A splat facing away is only ever seen edge-on at a silhouette, where its front-facing neighbours
+    // cover the same pixels: dropping it halves the work and keeps the far side of thin parts hidden.
+    if (dot(n, rs_to_eye(c)) < u_cull_cos) {
+        rs_sprite_cull();
+        return;
+    }
+    v_c = c;
+    v_n = n;
+    v_r = s.radius * u_radius_scale;
+#ifdef RS_PICK
+    v_id = rs_splat_index() + 1u;
+#endif
+    rs_sprite(c, v_r * u_coverage);
+}

@@ -1,0 +1,62 @@
+// render_composite.c — stage 5 (paper Fig. 2, eq. 1): a full-screen pass that normalises the attribute
+// sums, evaluates the Kelemen/Szirmay-Kalos specular S per pixel, reads D from stage 4 and writes
+// F = A (D + S) (RS_COMPOSITE_PAPER, the default: the paper's composite, which tints the highlight by
+// the skin colour) or F = A D + S (RS_COMPOSITE_PHYSICAL: a dielectric's white highlight), then exposure
+// and sRGB into the RGBA8 output. The debug views are branches of the same pass.
+#include "render/render_internal.h"
+
+#include <math.h>
+
+static float srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
+{
+    GLuint prog;
+    rs_result res = rs_render_program(r, RS_PROG_COMPOSITE, false, &prog, err);
+    if (res != RS_OK) return res;
+    const rs_camera *cam = &f->cam;
+    const rs_view *v = &f->view;
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_out);
+    glViewport(0, 0, cam->width, cam->height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(prog);
+    glUniformMatrix4fv(rs_uloc(prog, "u_proj"), 1, GL_FALSE, (const float *)cam->proj);
+    glUniformMatrix4fv(rs_uloc(prog, "u_inv_proj"), 1, GL_FALSE, (const float *)cam->inv_proj);
+    glUniform2f(rs_uloc(prog, "u_viewport"), (float)cam->width, (float)cam->height);
+    glUniform1f(rs_uloc(prog, "u_eps"), f->eps);
+    glUniform1i(rs_uloc(prog, "u_mode"), (int)v->mode);
+    glUniform1i(rs_uloc(prog, "u_physical"), v->composite == RS_COMPOSITE_PHYSICAL ? 1 : 0);
+    glUniform1f(rs_uloc(prog, "u_exposure"), v->exposure);
+    glUniform1f(rs_uloc(prog, "u_linear_output"), v->linear_output ? 1.0f : 0.0f);
+    // The background is given in sRGB; linear output shows it linear too.
+    float bg[3];
+    for (int c = 0; c < 3; c++) {
+        float b = RS_CLAMP(v->background[c], 0.0f, 1.0f);
+        bg[c] = v->linear_output ? srgb_to_linear(b) : b;
+    }
+    glUniform3fv(rs_uloc(prog, "u_background"), 1, bg);
+    glUniform1f(rs_uloc(prog, "u_rho_s_scale"), v->rho_s_scale);
+    glUniform1f(rs_uloc(prog, "u_diffuse_scale"), r->float_rt ? 1.0f : 1.0f / RS_DIFFUSE_SCALE_RGBA8);
+    glUniform3fv(rs_uloc(prog, "u_delta_weight"), 1, f->delta_weight);
+    glUniform3fv(rs_uloc(prog, "u_key_dir"), 1, f->key_dir);
+    glUniform3fv(rs_uloc(prog, "u_key_color"), 1, f->key_color);
+    glUniform3fv(rs_uloc(prog, "u_fill_dir"), 1, f->fill_dir);
+    glUniform3fv(rs_uloc(prog, "u_fill_color"), 1, f->fill_color);
+    glUniform3fv(rs_uloc(prog, "u_ambient"), 1, f->ambient);
+    // RGBA8 fallback: a sum of a few 8-bit steps is a faint disk rim rounded to garbage colours; such
+    // pixels are filled from their neighbours like holes.
+    glUniform1f(rs_uloc(prog, "u_min_weight"), r->float_rt ? 0.0f : RS_MIN_WEIGHT_RGBA8);
+    rs_render_shadow_uniforms(r, f, prog);
+    rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+    for (int i = 0; i < 3; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
+    rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
+    for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_LEVEL; i++) rs_render_bind_texture(i, 0);
+    return RS_OK;
+}

@@ -1,0 +1,165 @@
+// render_internal.h — what the renderer's stage files share: the renderer object, the per-frame state
+// (camera, lights, LOD), lazily compiled programs, targets, and the diffusion level plan.
+// Not public API: render.h is. One file per stage of the paper's Fig. 2:
+//   render_shadow.c (1), render_visibility.c (2), render_attribute.c (3), render_diffusion.c (4),
+//   render_composite.c (5); render_pick.c is the ID buffer; render.c the object, camera and frame.
+#ifndef RS_RENDER_INTERNAL_H
+#define RS_RENDER_INTERNAL_H
+
+#include "profile.h"
+#include "render/render.h"
+
+#include <cglm/cglm.h>
+
+// Programs; the splat programs exist twice (point sprites, instanced quads).
+typedef enum rs_prog {
+    RS_PROG_SHADOW = 0,
+    RS_PROG_VISIBILITY,
+    RS_PROG_PICK,
+    RS_PROG_ATTRIBUTE,
+    RS_PROG_DIFFUSION,
+    RS_PROG_SPLAT_COUNT,
+    RS_PROG_RESOLVE = RS_PROG_SPLAT_COUNT,
+    RS_PROG_COMPOSITE,
+    RS_PROG_IRRADIANCE,     // transform feedback: per-splat irradiance for stage 4
+    RS_PROG_COUNT
+} rs_prog;
+
+// Fixed texture units (set once per program when it is linked).
+enum {
+    RS_UNIT_DEPTH = 0,   // visibility depth (u_depth)
+    RS_UNIT_SHADOW,      // shadow map (u_shadow_map, compare mode)
+    RS_UNIT_ATTR0,       // attribute targets (u_attr0..2)
+    RS_UNIT_ATTR1,
+    RS_UNIT_ATTR2,
+    RS_UNIT_DIFFUSE,     // D (u_diffuse)
+    RS_UNIT_LEVEL,       // one diffusion level's accumulation (u_level)
+};
+
+// Disks are drawn (visibility, attributes, shadow map, ID buffer) out to RS_COVERAGE radii; the
+// attribute weight stays a Gaussian of the distance in radii, so the extra rim only matters where nothing
+// else covers a pixel: random samplings leave gaps of up to ~2 spacings that radii from k-nearest-neighbour
+// distances don't close (measured on the 600k head at 1024^2: ~340 pinholes at 1.0, none left at 1.3 but
+// single-pixel cracks at grazing creases, which the composite's hole filling takes).
+#define RS_COVERAGE 1.3f
+
+// Texture formats of the accumulation targets: RGBA16F when the driver renders to half floats, else the
+// documented RGBA8 fallback with pre-scaled sums (render_attribute.c, render_diffusion.c).
+#define RS_ATTR_WEIGHT_SCALE_RGBA8 0.2f
+#define RS_ATTR_WEIGHT_FLOOR_RGBA8 0.15f
+#define RS_MIN_WEIGHT_RGBA8 (5.5f / 255.0f)  // attribute sums below this are rounding noise: holes
+#define RS_DIFFUSE_SCALE_RGBA8 0.5f  // D stored halved (D reaches ~1.5 with a fill light)
+
+typedef struct rs_camera {
+    mat4 view, inv_view;     // model <-> view (rigid: lengths are model units)
+    mat4 proj, inv_proj;     // view -> clip, with the pan folded in
+    vec3 eye;                // model space
+    float near_z, far_z;     // positive distances
+    int width, height;
+    float px_size;           // size of a pixel at view distance 1, view units (2 tan(fov/2) / height)
+    float ppu_max;           // pixels per unit at the nearest point of the cloud's bounding sphere
+} rs_camera;
+
+// One Gaussian of the diffusion profile as drawn: stage 4 loops over these (reference: d'Eon's six, with
+// identical narrow ones merged; the mobile pipeline: its K fitted Gaussians at coarser LOD).
+typedef struct rs_diffusion_level {
+    float sigma;        // kernel sigma, model units (sqrt(variance_mm2) / mm_per_unit)
+    float weight[3];    // RGB weight of this level in D
+    uint32_t count;     // LOD prefix drawn
+    bool quads;         // instanced quads (the kernel sprite outgrows point sprites)
+} rs_diffusion_level;
+
+typedef struct rs_frame {
+    rs_view view;            // with zero fields replaced by their defaults
+    rs_camera cam;
+    uint32_t count;          // splats in the main passes (an LOD prefix)
+    float radius_scale;      // rs_splat_lod_radius_scale(count)
+    bool quads;              // main passes drawn as instanced quads
+    float eps;               // visibility push along the view ray, model units
+    bool lit;                // mode needs lights (shadow map, irradiance)
+    bool diffuse;            // mode needs stage 4
+    bool shadows;            // key light shadow-mapped
+    vec3 key_dir, key_color;     // view space, towards the light; linear RGB * intensity
+    vec3 fill_dir, fill_color;   // fill_color zero when off
+    vec3 ambient;
+    mat4 shadow_matrix;      // view space -> light clip space
+    float shadow_bias, shadow_offset, shadow_texel;
+    float delta_weight[3];   // profile weight taken by per-pixel irradiance (stage 4's narrow Gaussians)
+} rs_frame;
+
+struct rs_renderer {
+    const rs_splat_cloud *cloud;
+    rs_gl_caps caps;
+    bool float_rt;
+    bool time_stages;
+    float radius_median;        // model units, full cloud
+    float bound_centre[3], bound_radius;  // bounding sphere of the quantization box
+
+    GLuint vbo_splats, vbo_makeup;
+    GLuint vbo_irradiance;      // per splat (E, behind), 16 bytes, written by the irradiance pass
+    GLuint vao_points, vao_quads, vao_empty;
+    GLuint vao_feedback;        // the splats alone (the irradiance buffer is the feedback target there)
+    GLuint prog[RS_PROG_COUNT][2];   // [kind][quads]; 0 until first use
+
+    // Frame targets (width x height).
+    int tw, th;
+    GLuint depth_tex, attr_tex[3], level_tex, diffuse_tex, out_tex;
+    GLuint fbo_vis, fbo_attr, fbo_level, fbo_diffuse, fbo_out;
+    bool have_frame;
+
+    // Shadow map, re-rendered only when the light or the LOD changes.
+    GLuint shadow_tex, fbo_shadow;
+    int shadow_size;
+    mat4 shadow_vp;             // model -> light clip
+    float shadow_key[5];        // light dir, count, valid
+    float shadow_radius;        // typical splat radius in the map, model units
+
+    // ID buffer, re-rendered only when the view changes.
+    int pw, ph;
+    GLuint pick_tex, pick_depth, fbo_pick;
+    rs_view pick_view;
+    bool pick_valid;
+
+    rs_makeup_uniforms makeup_uni;  // makeup.glsl's colour range
+
+    // Mobile profile cache (rs_profile_fit is ~1 ms).
+    rs_profile fit;
+    int fit_k;
+    float fit_footprint;
+
+    rs_render_stats stats;
+};
+
+// render.c
+void rs_render_frame_setup(const rs_renderer *r, const rs_view *view, rs_frame *f);
+void rs_render_camera(const rs_renderer *r, const rs_view *view, rs_camera *cam);
+rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *out, rs_error *err);
+// Uniforms every splat program shares: transform, sprite placement, LOD radius, culling.
+void rs_render_splat_uniforms(GLuint prog, const mat4 view, const mat4 proj, const mat4 inv_proj, int w, int h,
+                              bool persp, float radius_scale, float cull_cos, float point_max);
+void rs_render_draw_splats(const rs_renderer *r, uint32_t count, bool quads);
+// Quads when a sphere of radius `radius` (model units) at the nearest depth outgrows point sprites.
+bool rs_render_needs_quads(const rs_renderer *r, const rs_frame *f, float radius);
+rs_result rs_render_fbo_check(const char *what, rs_error *err);
+GLuint rs_render_texture(GLenum internal_format, int w, int h);
+void rs_render_bind_texture(int unit, GLuint tex);
+// Sets the shadow_lookup.glsl uniforms for the frame.
+void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
+
+// The stages.
+rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err);
+rs_result rs_render_visibility(rs_renderer *r, const rs_frame *f, rs_error *err);
+rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err);
+// Fills levels[] for the frame's pipeline and returns their number; delta_weight gets the summed RGB
+// weights of the Gaussians too narrow to draw (the composite adds them as per-pixel irradiance).
+int rs_render_diffusion_plan(rs_renderer *r, const rs_frame *f, rs_diffusion_level levels[RS_PROFILE_MAX],
+                             float delta_weight[3]);
+rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
+                              rs_error *err);
+rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err);
+void rs_render_pick_release(rs_renderer *r);
+void rs_render_shadow_release(rs_renderer *r);
+
+static inline GLint rs_uloc(GLuint prog, const char *name) { return glGetUniformLocation(prog, name); }
+
+#endif

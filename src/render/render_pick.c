@@ -1,0 +1,102 @@
+// render_pick.c — the ID buffer for painting (paper §3.1: "the 2D cursor becomes a 3D point by reading the
+// splat index stored in an FBO"): the visibility pass's ray-disk shader, without the push, writing
+// index + 1 into an R32UI target (0 = background). Rendered on demand and cached while the view's
+// geometry (size, camera, LOD, primitive) stays the same, so a stroke of many stamps renders it once.
+#include "render/render_internal.h"
+
+#include <string.h>
+
+#define CULL_COS -0.25f
+
+void rs_render_pick_release(rs_renderer *r)
+{
+    glDeleteFramebuffers(1, &r->fbo_pick);
+    GLuint t[2] = {r->pick_tex, r->pick_depth};
+    glDeleteTextures(2, t);
+    r->fbo_pick = r->pick_tex = r->pick_depth = 0;
+    r->pw = r->ph = 0;
+    r->pick_valid = false;
+}
+
+static bool same_geometry(const rs_view *a, const rs_view *b)
+{
+    return a->width == b->width && a->height == b->height && a->yaw_deg == b->yaw_deg &&
+           a->pitch_deg == b->pitch_deg && a->zoom == b->zoom && a->fov_deg == b->fov_deg &&
+           a->pan[0] == b->pan[0] && a->pan[1] == b->pan[1] && a->max_splats == b->max_splats &&
+           a->prim == b->prim && a->pipeline == b->pipeline;
+}
+
+static bool ensure_pick_targets(rs_renderer *r, int w, int h)
+{
+    if (r->pw == w && r->ph == h) return true;
+    rs_render_pick_release(r);
+    r->pick_tex = rs_render_texture(GL_R32UI, w, h);
+    r->pick_depth = rs_render_texture(GL_DEPTH_COMPONENT32F, w, h);
+    glGenFramebuffers(1, &r->fbo_pick);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_pick);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, r->pick_tex, 0);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r->pick_depth, 0);
+    bool ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!ok) {
+        rs_render_pick_release(r);
+        return false;
+    }
+    r->pw = w;
+    r->ph = h;
+    return true;
+}
+
+static bool render_ids(rs_renderer *r, const rs_view *view)
+{
+    rs_frame f;
+    rs_render_frame_setup(r, view, &f);
+    if (!ensure_pick_targets(r, f.cam.width, f.cam.height)) return false;
+    GLuint prog;
+    rs_error err = {0};
+    if (rs_render_program(r, RS_PROG_PICK, f.quads, &prog, &err) != RS_OK) return false;
+    GLint saved_viewport[4];
+    glGetIntegerv(GL_VIEWPORT, saved_viewport);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_pick);
+    glViewport(0, 0, f.cam.width, f.cam.height);
+    const GLuint zero[4] = {0, 0, 0, 0};
+    glClearBufferuiv(GL_COLOR, 0, zero);
+    glClearDepthf(1.0f);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_BLEND);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glUseProgram(prog);
+    rs_render_splat_uniforms(prog, f.cam.view, f.cam.proj, f.cam.inv_proj, f.cam.width, f.cam.height, true,
+                             f.radius_scale, CULL_COS, r->caps.point_size_max);
+    glUniform1f(rs_uloc(prog, "u_eps"), 0.0f);
+    rs_render_draw_splats(r, f.count, f.quads);
+    glDisable(GL_DEPTH_TEST);
+    glBindVertexArray(0);
+    glUseProgram(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(saved_viewport[0], saved_viewport[1], saved_viewport[2], saved_viewport[3]);
+    r->pick_view = *view;
+    r->pick_valid = true;
+    return true;
+}
+
+bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t *splat_index)
+{
+    if (!view || view->width <= 0 || view->height <= 0 || view->width > r->caps.max_texture_size ||
+        view->height > r->caps.max_texture_size)
+        return false;
+    if (!(x_px >= 0 && y_px >= 0 && x_px < (float)view->width && y_px < (float)view->height)) return false;
+    if (!r->pick_valid || !same_geometry(&r->pick_view, view))
+        if (!render_ids(r, view)) return false;
+    int x = (int)x_px, y = view->height - 1 - (int)y_px;
+    GLuint id[4] = {0, 0, 0, 0};
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_pick);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glReadPixels(x, y, 1, 1, GL_RGBA_INTEGER, GL_UNSIGNED_INT, id);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (glGetError() != GL_NO_ERROR || id[0] == 0 || id[0] > r->cloud->hdr.count) return false;
+    *splat_index = id[0] - 1;
+    return true;
+}

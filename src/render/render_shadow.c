@@ -1,0 +1,133 @@
+// render_shadow.c — stage 1, the shadow map (paper Fig. 2): the splats' depth seen from the key light,
+// an orthographic frustum fitted to the cloud's bounding sphere, drawn with the visibility pass's ray-disk
+// shader (no push). Lookups (shaders_es/shadow_lookup.glsl) use a normal offset and a depth bias of about
+// one splat radius (acne comes from neighbouring disks disagreeing by up to that much) and a 3x3 grid of
+// hardware 2x2 PCF. The map only depends on the light and the LOD, so it is cached across camera moves.
+#include "render/render_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+// 2048^2 keeps a texel near 0.3 mm on the bundled bust (bounding sphere ~6 units, 47 mm/unit).
+#define SHADOW_SIZE 2048
+
+void rs_render_shadow_release(rs_renderer *r)
+{
+    glDeleteFramebuffers(1, &r->fbo_shadow);
+    glDeleteTextures(1, &r->shadow_tex);
+    r->fbo_shadow = r->shadow_tex = 0;
+    r->shadow_size = 0;
+    r->shadow_key[4] = 0;
+}
+
+static rs_result ensure_map(rs_renderer *r, rs_error *err)
+{
+    if (r->shadow_tex) return RS_OK;
+    int size = RS_MIN(SHADOW_SIZE, r->caps.max_texture_size);
+    r->shadow_tex = rs_render_texture(GL_DEPTH_COMPONENT32F, size, size);
+    // Hardware PCF: compare mode + linear filtering gives a bilinear 2x2 comparison per lookup.
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glGenFramebuffers(1, &r->fbo_shadow);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_shadow);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r->shadow_tex, 0);
+    GLenum none = GL_NONE;
+    glDrawBuffers(1, &none);
+    glReadBuffer(GL_NONE);
+    char what[64];
+    snprintf(what, sizeof what, "shadow map (DEPTH_COMPONENT32F %dx%d)", size, size);
+    rs_result res = rs_render_fbo_check(what, err);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (res != RS_OK) {
+        rs_render_shadow_release(r);
+        return res;
+    }
+    r->shadow_size = size;
+    return RS_OK;
+}
+
+// Light view and orthographic projection around the cloud's bounding sphere; L points towards the light.
+static void light_matrices(const rs_renderer *r, const vec3 L, mat4 view, mat4 proj)
+{
+    vec3 c = {r->bound_centre[0], r->bound_centre[1], r->bound_centre[2]}, eye, up = {0, 1, 0};
+    float R = r->bound_radius;
+    for (int a = 0; a < 3; a++) eye[a] = c[a] + L[a] * 2.0f * R;
+    const float *fu = r->cloud->hdr.up;
+    glm_vec3_copy((float *)fu, up);
+    if (fabsf(glm_vec3_dot(up, (float *)L)) > 0.95f) glm_vec3_copy((float *)r->cloud->hdr.forward, up);
+    glm_lookat(eye, c, up, view);
+    glm_ortho(-R, R, -R, R, R * 0.99f, R * 3.01f, proj);
+}
+
+rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
+{
+    rs_result res = ensure_map(r, err);
+    if (res != RS_OK) return res;
+    // The key light direction back in model space.
+    vec3 L;
+    mat3 inv_rot;
+    glm_mat4_pick3(f->cam.inv_view, inv_rot);
+    glm_mat3_mulv(inv_rot, f->key_dir, L);
+    glm_vec3_normalize(L);
+    uint32_t count = f->count;
+    float scale = rs_splat_lod_radius_scale(r->cloud, count);
+    float R = r->bound_radius;
+    float key[5] = {L[0], L[1], L[2], (float)count, 1.0f};
+    bool cached = true;
+    for (int i = 0; i < 5; i++) cached = cached && fabsf(key[i] - r->shadow_key[i]) < 1e-6f;
+
+    mat4 view, proj, inv_proj;
+    light_matrices(r, L, view, proj);
+    glm_mat4_inv(proj, inv_proj);
+    glm_mat4_mul(proj, view, r->shadow_vp);
+    if (!cached) {
+        GLuint prog;
+        bool quads = f->view.prim == RS_PRIM_QUADS;
+        float texels_per_unit = (float)r->shadow_size / (2.0f * R);
+        float size = 2.0f * r->cloud->hdr.radius_max * RS_COVERAGE * scale * texels_per_unit + 2.0f;
+        if (f->view.prim == RS_PRIM_AUTO && size > r->caps.point_size_max) quads = true;
+        res = rs_render_program(r, RS_PROG_SHADOW, quads, &prog, err);
+        if (res != RS_OK) return res;
+        glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_shadow);
+        glViewport(0, 0, r->shadow_size, r->shadow_size);
+        glDisable(GL_BLEND);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDepthMask(GL_TRUE);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glUseProgram(prog);
+        // Splats facing well away from the light are behind its front surface anyway.
+        rs_render_splat_uniforms(prog, view, proj, inv_proj, r->shadow_size, r->shadow_size, false, scale, -0.3f,
+                                 r->caps.point_size_max);
+        glUniform1f(rs_uloc(prog, "u_eps"), 0.0f);
+        rs_render_draw_splats(r, count, quads);
+        memcpy(r->shadow_key, key, sizeof key);
+        r->shadow_radius = r->radius_median * scale;
+    }
+    // Lookups come from view space: view -> model -> light clip.
+    glm_mat4_mul(r->shadow_vp, f->cam.inv_view, f->shadow_matrix);
+    f->shadow_texel = 1.0f / (float)r->shadow_size;
+    // A disk departs from the surface it samples by ~r^2 / 2R at its rim (curvature radius R ~ 0.3 of
+    // the face height on cheeks and nose) plus r sin(3 deg) from normal noise: ~0.15 r on the bundled
+    // head; a texel of quantisation on top. Depth bias in window units (the ortho range is 2.02 R).
+    float texel = 2.0f * R / (float)r->shadow_size;
+    f->shadow_bias = (0.15f * r->shadow_radius + texel) / (2.02f * R);
+    // Normal offset: a texel and a half (the PCF grid's step) plus the same disk departure.
+    f->shadow_offset = 1.5f * texel + 0.15f * r->shadow_radius;
+    // The PCF grid reaches 3.25 texels sideways: on slopes that is depth too.
+    f->shadow_bias += 1.5f * texel / (2.02f * R);
+    return rs_gl_check("render: shadow map", err);
+}
+
+void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog)
+{
+    rs_render_bind_texture(RS_UNIT_SHADOW, f->shadows ? r->shadow_tex : 0);
+    glUniform1f(rs_uloc(prog, "u_shadow_on"), f->shadows && r->shadow_tex ? 1.0f : 0.0f);
+    glUniformMatrix4fv(rs_uloc(prog, "u_shadow_matrix"), 1, GL_FALSE, (const float *)f->shadow_matrix);
+    glUniform1f(rs_uloc(prog, "u_shadow_texel"), f->shadow_texel);
+    glUniform1f(rs_uloc(prog, "u_shadow_bias"), f->shadow_bias);
+    glUniform1f(rs_uloc(prog, "u_shadow_offset"), f->shadow_offset);
+    glUniform3fv(rs_uloc(prog, "u_shadow_dir"), 1, f->key_dir);
+}

@@ -1,0 +1,694 @@
+// test_render.c — the reference pipeline, stage by stage, on the bundled face (assets/face.rsf; the
+// environment variable RS_TEST_FACE may name another .rsf), drawn from an LOD prefix of at most 50k splats
+// at 256x256 or less so each image costs well under a second on llvmpipe.
+//
+// Lit-image checks read linear output (rs_view.linear_output) so sums and ratios are in light units.
+#include "harness.h"
+#include "render/render.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SIZE 256
+#define MAX_SPLATS 50000
+
+static rs_gl_context *gl;
+static rs_splat_cloud *face;
+static rs_renderer *ren;
+static char face_why[600];
+
+// ---- helpers ----
+
+// Test view: 256^2, 50k splats, no ambient or fill, pure magenta background (never a skin colour).
+static rs_view test_view(rs_render_mode mode)
+{
+    rs_view v = rs_view_defaults();
+    v.width = v.height = SIZE;
+    v.max_splats = MAX_SPLATS;
+    v.mode = mode;
+    v.ambient = 0.0f;
+    v.background[0] = 1.0f, v.background[1] = 0.0f, v.background[2] = 1.0f;
+    return v;
+}
+
+static bool need_face(void)
+{
+    if (face && ren) return true;
+    rs_test_skip("%s", face_why);
+    return false;
+}
+
+static bool render(const rs_view *v, rs_image *img)
+{
+    rs_error err = {0};
+    return RS_CHECK(rs_render_image(ren, v, img, &err) == RS_OK, "render: %s", err.msg);
+}
+
+static const uint8_t *px(const rs_image *img, int x, int y) { return img->pixels + ((size_t)y * img->width + x) * img->channels; }
+
+static bool is_background(const rs_image *img, int x, int y)
+{
+    const uint8_t *p = px(img, x, y);
+    return p[0] == 255 && p[1] == 0 && p[2] == 255;
+}
+
+static double lin(const rs_image *img, int x, int y, int c) { return px(img, x, y)[c] / 255.0; }
+
+// Face pixels at least `margin` pixels away from the background (gradients at the silhouette are not
+// what the lighting tests are about).
+static bool interior(const rs_image *img, int x, int y, int margin)
+{
+    for (int dy = -margin; dy <= margin; dy++)
+        for (int dx = -margin; dx <= margin; dx++) {
+            int xx = x + dx, yy = y + dy;
+            if (xx < 0 || yy < 0 || xx >= img->width || yy >= img->height || is_background(img, xx, yy))
+                return false;
+        }
+    return true;
+}
+
+// Background pixels not connected to the image border: holes inside the silhouette.
+static int count_holes(const rs_image *img, int *face_px)
+{
+    int w = img->width, h = img->height, n = w * h;
+    uint8_t *seen = calloc((size_t)n, 1);
+    int *stack = malloc(sizeof(int) * (size_t)n * 4 + 64);
+    if (!seen || !stack) {
+        free(seen);
+        free(stack);
+        return -1;
+    }
+    int sp = 0;
+    for (int x = 0; x < w; x++) stack[sp++] = x, stack[sp++] = (h - 1) * w + x;
+    for (int y = 0; y < h; y++) stack[sp++] = y * w, stack[sp++] = y * w + w - 1;
+    while (sp) {
+        int i = stack[--sp];
+        if (seen[i] || !is_background(img, i % w, i / w)) continue;
+        seen[i] = 1;
+        int x = i % w, y = i / w;
+        if (x > 0) stack[sp++] = i - 1;
+        if (x < w - 1) stack[sp++] = i + 1;
+        if (y > 0) stack[sp++] = i - w;
+        if (y < h - 1) stack[sp++] = i + w;
+    }
+    int holes = 0, fg = 0;
+    for (int i = 0; i < n; i++) {
+        bool bg = is_background(img, i % w, i / w);
+        fg += !bg;
+        holes += bg && !seen[i];
+    }
+    free(seen);
+    free(stack);
+    *face_px = fg;
+    return holes;
+}
+
+// The splat furthest along the face's forward axis: the nose tip on a front-facing head.
+static uint32_t nose_tip(void)
+{
+    const float *f = face->hdr.forward;
+    uint32_t best = 0;
+    float best_d = -INFINITY;
+    for (uint32_t i = 0; i < face->hdr.count; i++) {
+        float d = face->pos[i][0] * f[0] + face->pos[i][1] * f[1] + face->pos[i][2] * f[2];
+        if (d > best_d) best_d = d, best = i;
+    }
+    return best;
+}
+
+static void save_pair(const char *name, const rs_image *a, const rs_image *b)
+{
+    char n[128];
+    snprintf(n, sizeof n, "%s.a", name);
+    rs_test_save(n, a);
+    snprintf(n, sizeof n, "%s.b", name);
+    rs_test_save(n, b);
+}
+
+// Sum of squared finite differences of channel c of img / (div (per pixel) or 1), over interior pixels.
+static double gradient_energy(const rs_image *img, const rs_image *div, int c, const rs_image *mask_img)
+{
+    double e = 0;
+    for (int y = 0; y < img->height - 1; y++)
+        for (int x = 0; x < img->width - 1; x++) {
+            if (!interior(mask_img, x, y, 3)) continue;
+            double v[3];
+            int xs[3] = {x, x + 1, x}, ys[3] = {y, y, y + 1};
+            for (int k = 0; k < 3; k++) {
+                v[k] = lin(img, xs[k], ys[k], c);
+                if (div) v[k] /= fmax(lin(div, xs[k], ys[k], c), 0.02);
+            }
+            e += (v[1] - v[0]) * (v[1] - v[0]) + (v[2] - v[0]) * (v[2] - v[0]);
+        }
+    return e;
+}
+
+// ---- stage 2: visibility ----
+
+static void test_visibility_leaves_no_holes_inside_silhouette(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_ALBEDO);
+    rs_image img = {0};
+    if (!render(&v, &img)) return;
+    int fg = 0, holes = count_holes(&img, &fg);
+    RS_CHECK(fg > SIZE * SIZE / 8, "the face covers only %d pixels", fg);
+    RS_CHECK(holes == 0, "%d background pixels inside the silhouette (of %d face pixels)", holes, fg);
+    if (holes) rs_test_save("render_holes", &img);
+    rs_image_free(&img);
+}
+
+static void test_coarse_lod_and_side_view_have_no_holes(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_ALBEDO);
+    v.max_splats = 20000;
+    v.yaw_deg = 60.0f;
+    v.pitch_deg = 15.0f;
+    rs_image img = {0};
+    if (!render(&v, &img)) return;
+    int fg = 0, holes = count_holes(&img, &fg);
+    RS_CHECK(holes == 0, "%d holes at 20k splats, yaw 60 (%d face pixels)", holes, fg);
+    if (holes) rs_test_save("render_holes_coarse", &img);
+    rs_image_free(&img);
+}
+
+static void test_points_and_quads_give_the_same_image(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_FULL);
+    v.prim = RS_PRIM_POINTS;
+    rs_image a = {0}, b = {0};
+    if (!render(&v, &a)) return;
+    RS_CHECK(rs_render_get_stats(ren).used_points, "forced points not used");
+    v.prim = RS_PRIM_QUADS;
+    if (render(&v, &b)) {
+        RS_CHECK(!rs_render_get_stats(ren).used_points, "forced quads not used");
+        rs_image_metrics m;
+        rs_error err = {0};
+        RS_REQUIRE(rs_image_compare(&a, &b, 2, &m, &err) == RS_OK, "%s", err.msg);
+        RS_CHECK(m.psnr >= 50.0 && m.frac_over <= 0.001, "points vs quads: PSNR %.1f dB, %.3f%% pixels off by > 2",
+                 m.psnr, 100 * m.frac_over);
+        if (m.psnr < 50.0) save_pair("render_points_quads", &a, &b);
+    }
+    rs_image_free(&a);
+    rs_image_free(&b);
+}
+
+// ---- stage 1: shadow map ----
+
+// Light from straight above the face: the nose shadows the philtrum.
+static void test_shadow_darkens_region_under_nose(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_FULL);
+    v.key.yaw_deg = 0.0f;
+    v.key.pitch_deg = 60.0f;
+    v.linear_output = true;
+    rs_image lit = {0}, shadowed = {0}, vis = {0};
+    if (!render(&v, &shadowed)) return;
+    v.no_shadows = true;
+    if (!render(&v, &lit)) goto done;
+    v.no_shadows = false;
+    v.mode = RS_MODE_SHADOW;
+    if (!render(&v, &vis)) goto done;
+    float tip[2];
+    RS_REQUIRE(rs_render_project(ren, &v, face->pos[nose_tip()], tip), "nose tip behind the camera");
+    // Between the nose and the mouth: 6-10% of the face height below the tip (the view shows the face
+    // height at 80% of the image; the nose's own underside reaches ~5% below its tip).
+    double fh = 0.8 * SIZE;
+    int x0 = (int)(tip[0] - 0.025 * fh), x1 = (int)(tip[0] + 0.025 * fh);
+    int y0 = (int)(tip[1] + 0.06 * fh), y1 = (int)(tip[1] + 0.10 * fh);
+    double sum_lit = 0, sum_sh = 0, sum_vis = 0;
+    int n = 0;
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            if (x < 0 || y < 0 || x >= SIZE || y >= SIZE || is_background(&lit, x, y)) continue;
+            for (int c = 0; c < 3; c++) sum_lit += lin(&lit, x, y, c), sum_sh += lin(&shadowed, x, y, c);
+            sum_vis += lin(&vis, x, y, 0);
+            n++;
+        }
+    RS_REQUIRE(n > 20, "under-nose box (%d..%d, %d..%d) has %d face pixels", x0, x1, y0, y1, n);
+    RS_CHECK(sum_vis / n < 0.5, "under the nose only %.0f%% occluded", 100 * (1 - sum_vis / n));
+    RS_CHECK(sum_sh < 0.8 * sum_lit, "under the nose: %.3f with shadows vs %.3f without", sum_sh / n, sum_lit / n);
+    if (sum_sh >= 0.8 * sum_lit) save_pair("render_shadow_nose", &shadowed, &lit);
+done:
+    rs_image_free(&lit);
+    rs_image_free(&shadowed);
+    rs_image_free(&vis);
+}
+
+// Bias and PCF: a forehead facing the light is fully lit (no acne), with the light from above or the side.
+static void test_shadow_map_has_no_acne_on_lit_forehead(void)
+{
+    if (!need_face()) return;
+    float lights[3][2] = {{0.0f, 60.0f}, {-35.0f, 30.0f}, {40.0f, 10.0f}};
+    for (int l = 0; l < 3; l++) {
+        rs_view v = test_view(RS_MODE_SHADOW);
+        v.key.yaw_deg = lights[l][0];
+        v.key.pitch_deg = lights[l][1];
+        rs_image img = {0};
+        if (!render(&v, &img)) return;
+        // Forehead: 32-45% of the face height above the nose tip, +-8% across.
+        float tip[2];
+        RS_REQUIRE(rs_render_project(ren, &v, face->pos[nose_tip()], tip), "nose tip behind the camera");
+        double fh = 0.8 * SIZE;
+        int n = 0, dark = 0;
+        for (int y = (int)(tip[1] - 0.45 * fh); y <= (int)(tip[1] - 0.32 * fh); y++)
+            for (int x = (int)(tip[0] - 0.08 * fh); x <= (int)(tip[0] + 0.08 * fh); x++) {
+                if (x < 0 || y < 0 || x >= SIZE || y >= SIZE || is_background(&img, x, y)) continue;
+                n++;
+                dark += px(&img, x, y)[0] < 242;  // visibility below 0.95
+            }
+        RS_CHECK(n > 100 && dark <= n / 200, "light yaw %g pitch %g: %d of %d forehead pixels in shadow",
+                 lights[l][0], lights[l][1], dark, n);
+        if (dark > n / 200) rs_test_save("render_shadow_acne", &img);
+        rs_image_free(&img);
+    }
+}
+
+// ---- stage 4: diffusion ----
+
+// D (diffuse / albedo) has softer light-to-shadow transitions than the plain per-pixel N.L * shadow, and
+// red light (the profile's wide Gaussians) reaches farther into the shadow than blue light.
+static void test_diffusion_softens_terminator_and_red_reaches_farther(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_IRRADIANCE);
+    v.key.yaw_deg = -60.0f;  // a long terminator across the face, and the nose's shadow
+    v.key.pitch_deg = 20.0f;
+    v.linear_output = true;
+    rs_image irr = {0}, dif = {0}, alb = {0}, bright = {0};
+    if (!render(&v, &irr)) return;
+    v.mode = RS_MODE_DIFFUSE;
+    if (!render(&v, &dif)) goto done;
+    // The light that leaks into the shadow is a few percent: exposed x8 it isn't lost to 8-bit rounding.
+    v.exposure = 8.0f;
+    if (!render(&v, &bright)) goto done;
+    v.mode = RS_MODE_ALBEDO;
+    if (!render(&v, &alb)) goto done;
+    // Red is the channel the profile spreads widest; green and blue spread less than a pixel here but
+    // must not come out sharper than N.L.
+    double g_irr = gradient_energy(&irr, NULL, 1, &irr), g_dif[3];
+    for (int c = 0; c < 3; c++) g_dif[c] = gradient_energy(&dif, &alb, c, &irr);
+    RS_CHECK(g_dif[0] < 0.8 * g_irr, "diffuse red gradient energy %.2f not below 0.8 x N.L's %.2f", g_dif[0], g_irr);
+    RS_CHECK(g_dif[1] < 1.1 * g_irr && g_dif[2] < 1.1 * g_irr, "diffuse green/blue gradient energy %.2f/%.2f "
+             "above N.L's %.2f", g_dif[1], g_dif[2], g_irr);
+    // Light that arrived in the dark: D per channel over pixels that N.L * shadow leaves black, within
+    // 4 pixels (~4 mm) of lit skin.
+    double dark[3] = {0, 0, 0};
+    int n = 0;
+    for (int y = 4; y < SIZE - 4; y++)
+        for (int x = 4; x < SIZE - 4; x++) {
+            if (!interior(&irr, x, y, 3) || px(&irr, x, y)[1] > 2) continue;
+            bool near_lit = false;
+            for (int k = 0; k < 81 && !near_lit; k++) near_lit = px(&irr, x + k % 9 - 4, y + k / 9 - 4)[1] > 25;
+            if (!near_lit) continue;
+            for (int c = 0; c < 3; c++) dark[c] += lin(&bright, x, y, c) / 8.0 / fmax(lin(&alb, x, y, c), 0.02);
+            n++;
+        }
+    RS_REQUIRE(n > 200, "only %d dark face pixels", n);
+    RS_CHECK(dark[0] > 1.3 * dark[2], "light in the shadow: red %.2f, blue %.2f (mean over %d px)", dark[0] / n,
+             dark[2] / n, n);
+    if (g_dif[0] >= 0.8 * g_irr || dark[0] <= 1.3 * dark[2]) save_pair("render_diffusion", &bright, &irr);
+done:
+    rs_image_free(&bright);
+    rs_image_free(&irr);
+    rs_image_free(&dif);
+    rs_image_free(&alb);
+}
+
+// Across the terminator, lit skin light leaks into the shadow side: the diffuse image is brighter than
+// N.L just inside the shadow, and darker just inside the light (energy moves, it is not created).
+static void test_diffusion_conserves_energy_on_average(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_IRRADIANCE);
+    v.key.yaw_deg = -60.0f;
+    v.key.pitch_deg = 20.0f;
+    v.linear_output = true;
+    rs_image irr = {0}, dif = {0}, alb = {0};
+    if (!render(&v, &irr)) return;
+    v.mode = RS_MODE_DIFFUSE;
+    if (!render(&v, &dif)) goto done;
+    v.mode = RS_MODE_ALBEDO;
+    if (!render(&v, &alb)) goto done;
+    double si = 0, sd = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            if (!interior(&irr, x, y, 3)) continue;
+            si += lin(&irr, x, y, 1);
+            sd += lin(&dif, x, y, 1) / fmax(lin(&alb, x, y, 1), 0.02);
+        }
+    RS_CHECK(fabs(sd / si - 1.0) < 0.08, "mean D / mean N.L = %.3f", sd / si);
+done:
+    rs_image_free(&irr);
+    rs_image_free(&dif);
+    rs_image_free(&alb);
+}
+
+// ---- stage 5: specular and composite ----
+
+static double image_sum(const rs_image *img, int c)
+{
+    double s = 0;
+    for (int y = 0; y < img->height; y++)
+        for (int x = 0; x < img->width; x++) s += lin(img, x, y, c);
+    return s;
+}
+
+static void test_specular_energy_doubles_with_rho_s(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_SPECULAR);
+    v.linear_output = true;
+    v.exposure = 6.0f;  // S peaks near 0.05: keep the doubled image below 1 without rounding it away
+    v.background[0] = v.background[1] = v.background[2] = 0.0f;
+    rs_image a = {0}, b = {0};
+    if (!render(&v, &a)) return;
+    v.rho_s_scale = 2.0f;
+    if (render(&v, &b)) {
+        double sa = image_sum(&a, 1), sb = image_sum(&b, 1);
+        RS_CHECK(sa > 100.0, "specular image nearly black (sum %.1f)", sa);
+        RS_CHECK(sb / sa > 1.9 && sb / sa < 2.1, "doubling rho_s scaled the specular energy by %.3f", sb / sa);
+    }
+    rs_image_free(&a);
+    rs_image_free(&b);
+}
+
+// Same geometry, two region tables: with the nose's measured (m, rho_s) the nose's highlight is brighter
+// than with the cheek's parameters (higher rho_s, sharper lobe), and cheek pixels don't change. Compared
+// where the lobe is (pixels at >= 40% of the nose's peak): away from it a sharper lobe is darker.
+static void test_nose_specular_brighter_than_cheek_at_matching_geometry(void)
+{
+    if (!need_face()) return;
+    rs_splat_header *h = &face->hdr;
+    if (face->region_counts[RS_REGION_NOSE] == 0 || face->region_counts[RS_REGION_CHEEK] == 0) {
+        RS_CHECK(false, "the face has no nose or no cheek splats: region segmentation missing");
+        return;
+    }
+    rs_view v = test_view(RS_MODE_REGIONS);
+    // Light from the camera: the highlight sits where the surface faces the viewer (nose tip, cheeks).
+    v.key.yaw_deg = 0.0f;
+    v.key.pitch_deg = 5.0f;
+    rs_image reg = {0}, a = {0}, b = {0};
+    if (!render(&v, &reg)) return;
+    v.mode = RS_MODE_SPECULAR;
+    v.linear_output = true;
+    v.exposure = 4.0f;
+    if (!render(&v, &a)) goto done;
+    rs_region_info nose = h->regions[RS_REGION_NOSE];
+    h->regions[RS_REGION_NOSE] = h->regions[RS_REGION_CHEEK];
+    bool ok = render(&v, &b);
+    h->regions[RS_REGION_NOSE] = nose;
+    if (!ok) goto done;
+    // The regions view paints the nose green and the cheeks red (render_attribute.c palette).
+    double peak = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        double sn[2] = {0, 0}, sc[2] = {0, 0};
+        for (int y = 0; y < SIZE; y++)
+            for (int x = 0; x < SIZE; x++) {
+                const uint8_t *p = px(&reg, x, y);
+                bool is_nose = p[1] > 150 && p[0] < 110 && p[2] < 110;
+                bool is_cheek = p[0] > 200 && p[1] < 120 && p[2] < 120;
+                double sa = lin(&a, x, y, 1), sb = lin(&b, x, y, 1);
+                if (pass == 0) {
+                    if (is_nose) peak = fmax(peak, sb);
+                    continue;
+                }
+                if (is_nose && sb >= 0.4 * peak) sn[0] += sa, sn[1] += sb;
+                if (is_cheek) sc[0] += sa, sc[1] += sb;
+            }
+        if (pass == 0) continue;
+        RS_REQUIRE(peak > 0.05 && sc[1] > 1.0, "no specular on the nose (peak %.3f) or cheeks (%.2f)", peak, sc[1]);
+        RS_CHECK(sn[0] / sn[1] > 1.2, "nose highlight with its own parameters / with the cheek's = %.3f",
+                 sn[0] / sn[1]);
+        RS_CHECK(fabs(sc[0] / sc[1] - 1.0) < 0.02, "cheek specular changed by %.3f", sc[0] / sc[1]);
+    }
+done:
+    rs_image_free(&reg);
+    rs_image_free(&a);
+    rs_image_free(&b);
+}
+
+// F = A (D + S) per pixel against the separately rendered albedo, diffuse (= A D) and specular (= S)
+// images, and F = A D + S for the physical composite; linear 8-bit output, so within rounding.
+static void test_composite_is_albedo_times_diffuse_plus_specular(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_ALBEDO);
+    v.linear_output = true;
+    v.exposure = 0.9f;  // keep F below 1 (no clamping)
+    v.background[0] = v.background[1] = v.background[2] = 0.0f;
+    rs_image A = {0}, D = {0}, S = {0}, F = {0}, P = {0};
+    rs_image *imgs[5] = {&A, &D, &S, &F, &P};
+    rs_render_mode modes[5] = {RS_MODE_ALBEDO, RS_MODE_DIFFUSE, RS_MODE_SPECULAR, RS_MODE_FULL, RS_MODE_FULL};
+    for (int i = 0; i < 5; i++) {
+        v.mode = modes[i];
+        v.composite = i == 4 ? RS_COMPOSITE_PHYSICAL : RS_COMPOSITE_PAPER;
+        if (!render(&v, imgs[i])) goto done;
+    }
+    int worst = 0, worst_phys = 0, n = 0, clipped = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++)
+            for (int c = 0; c < 3; c++) {
+                const uint8_t a = px(&A, x, y)[c], d = px(&D, x, y)[c], s = px(&S, x, y)[c];
+                if (px(&F, x, y)[c] == 255) clipped++;
+                double paper = d + a * s / 255.0, phys = d + s;
+                worst = RS_MAX(worst, (int)lround(fabs(px(&F, x, y)[c] - paper)));
+                worst_phys = RS_MAX(worst_phys, (int)lround(fabs(px(&P, x, y)[c] - fmin(phys, 255.0))));
+                n += s > 0;
+            }
+    RS_CHECK(n > 500, "specular nearly absent (%d samples)", n);
+    RS_CHECK(clipped == 0, "%d clipped samples: lower the exposure", clipped);
+    // Each 8-bit image rounds by half a step: F, D, A and S together by at most 2.
+    RS_CHECK(worst <= 2, "F vs A (D + S): largest difference %d/255", worst);
+    RS_CHECK(worst_phys <= 2, "F vs A D + S: largest difference %d/255", worst_phys);
+done:
+    for (int i = 0; i < 5; i++) rs_image_free(imgs[i]);
+}
+
+static void test_rgba8_fallback_is_close_to_float_targets(void)
+{
+    if (!need_face()) return;
+    rs_renderer *r8 = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl),
+                                                  .force_no_float_targets = true},
+                                &r8, &err) == RS_OK,
+               "%s", err.msg);
+    rs_view v = test_view(RS_MODE_FULL);
+    rs_image a = {0}, b = {0};
+    if (render(&v, &a) && RS_CHECK(rs_render_image(r8, &v, &b, &err) == RS_OK, "%s", err.msg)) {
+        RS_CHECK(!rs_render_get_stats(r8).float_targets, "fallback renderer reports float targets");
+        rs_image_metrics m;
+        // 8-bit blending is noisy where few splats overlap (render_attribute.c): a loose bound.
+        RS_REQUIRE(rs_image_compare(&a, &b, 16, &m, &err) == RS_OK, "%s", err.msg);
+        RS_CHECK(m.psnr >= 33.0 && m.ssim >= 0.95 && m.frac_over < 0.04, "RGBA8 vs float: PSNR %.1f dB, SSIM %.3f, "
+                 "%.2f%% pixels off by > 16", m.psnr, m.ssim, 100 * m.frac_over);
+        if (m.psnr < 33.0 || m.ssim < 0.95 || m.frac_over >= 0.04) save_pair("render_rgba8", &a, &b);
+    }
+    rs_image_free(&a);
+    rs_image_free(&b);
+    rs_render_destroy(r8);
+}
+
+// ---- golden images: the paper's Fig. 7 modes from one view ----
+
+static void golden(const char *name, rs_render_mode mode)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(mode);
+    v.width = v.height = 192;
+    v.background[0] = v.background[1] = v.background[2] = 0.16f;
+    v.ambient = 0.06f;
+    rs_image img = {0};
+    // Rasterisation differs a little between GPUs: a few percent of pixels may differ by more than 10.
+    if (render(&v, &img)) rs_test_golden(name, &img, 10, 0.03, 30.0);
+    rs_image_free(&img);
+}
+
+static void test_golden_albedo(void) { golden("render_albedo", RS_MODE_ALBEDO); }
+static void test_golden_diffuse(void) { golden("render_diffuse", RS_MODE_DIFFUSE); }
+static void test_golden_full(void) { golden("render_full", RS_MODE_FULL); }
+
+// ---- picking ----
+
+static void test_pick_returns_visible_splat_under_pixel_and_false_on_background(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_FULL);
+    uint32_t tip = nose_tip();
+    float p[2];
+    RS_REQUIRE(rs_render_project(ren, &v, face->pos[tip], p), "nose tip behind the camera");
+    uint32_t got = UINT32_MAX;
+    RS_REQUIRE(rs_render_pick(ren, &v, p[0], p[1], &got), "no splat at the nose tip (%.1f, %.1f)", p[0], p[1]);
+    uint32_t n = rs_splat_lod_count(face, MAX_SPLATS);
+    RS_CHECK(got < n, "picked splat %u outside the drawn prefix of %u", got, n);
+    // The picked disk covers the clicked pixel: its projected centre is within its projected radius.
+    float q[2];
+    RS_REQUIRE(rs_render_project(ren, &v, face->pos[got], q), "picked splat behind the camera");
+    float reach = face->radius[got] * rs_splat_lod_radius_scale(face, n) * 1.3f *
+                  rs_render_pixels_per_unit(ren, &v, face->pos[got]) + 1.0f;
+    float d = hypotf(q[0] - p[0], q[1] - p[1]);
+    RS_CHECK(d <= reach, "picked splat's centre is %.2f px from the click, its disk reaches %.2f px", d, reach);
+    // It is on the front surface: within a few radii of the tip along the view direction.
+    float dir[3];
+    rs_render_view_dir(ren, &v, face->pos[tip], dir);
+    float along = 0;
+    for (int a = 0; a < 3; a++) along += (face->pos[got][a] - face->pos[tip][a]) * dir[a];
+    RS_CHECK(fabsf(along) < 4.0f * face->radius[got] * rs_splat_lod_radius_scale(face, n), "picked splat %.4f units "
+             "off the front surface", along);
+    uint32_t none = 7;
+    RS_CHECK(!rs_render_pick(ren, &v, 2.0f, 2.0f, &none) && none == 7, "corner pixel picked splat %u", none);
+    RS_CHECK(!rs_render_pick(ren, &v, -1.0f, 10.0f, &none) && !rs_render_pick(ren, &v, 10.0f, (float)SIZE, &none),
+             "a pixel outside the view picked something");
+}
+
+// ---- API behaviour ----
+
+static void test_bad_views_are_refused_with_a_message(void)
+{
+    if (!need_face()) return;
+    rs_error err = {0};
+    rs_view v = test_view(RS_MODE_FULL);
+    v.width = 0;
+    RS_CHECK(rs_render_frame(ren, &v, &err) == RS_ERR_ARG && strstr(err.msg, "size"), "width 0: %s", err.msg);
+    v = test_view(RS_MODE_FULL);
+    v.height = 1 << 20;
+    RS_CHECK(rs_render_frame(ren, &v, &err) == RS_ERR_ARG, "height 2^20 accepted");
+    v = test_view(RS_MODE_FULL);
+    v.zoom = NAN;
+    RS_CHECK(rs_render_frame(ren, &v, &err) == RS_ERR_ARG, "NaN zoom accepted");
+    v = test_view(RS_MODE_FULL);
+    v.mode = RS_MODE_COUNT;
+    RS_CHECK(rs_render_frame(ren, &v, &err) == RS_ERR_ARG, "mode out of range accepted");
+    uint8_t rec[8] = {0};
+    RS_CHECK(rs_render_update_makeup(ren, face->hdr.count, 1, rec, &err) == RS_ERR_ARG, "makeup past the end");
+    RS_CHECK(rs_render_update_makeup(ren, 1, UINT32_MAX, rec, &err) == RS_ERR_ARG, "makeup count overflow");
+}
+
+static void test_frame_restores_gl_state(void)
+{
+    if (!need_face()) return;
+    glViewport(3, 4, 50, 60);
+    rs_view v = test_view(RS_MODE_ALBEDO);
+    v.width = v.height = 64;
+    rs_error err = {0};
+    RS_REQUIRE(rs_render_frame(ren, &v, &err) == RS_OK, "%s", err.msg);
+    GLint vp[4], fbo = -1;
+    glGetIntegerv(GL_VIEWPORT, vp);
+    glGetIntegerv(GL_FRAMEBUFFER_BINDING, &fbo);
+    RS_CHECK(vp[0] == 3 && vp[1] == 4 && vp[2] == 50 && vp[3] == 60, "viewport %d %d %d %d", vp[0], vp[1], vp[2], vp[3]);
+    RS_CHECK(fbo == 0, "framebuffer %d left bound", fbo);
+    RS_CHECK(!glIsEnabled(GL_BLEND) && !glIsEnabled(GL_DEPTH_TEST), "blend or depth test left on");
+    int w = 0, h = 0;
+    RS_CHECK(rs_render_output_texture(ren, &w, &h) != 0 && w == 64 && h == 64, "output texture %dx%d", w, h);
+}
+
+// A makeup record colours its splat's albedo; hide_makeup shows the base; zero records change nothing.
+static void test_makeup_records_reach_the_attribute_pass(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_ALBEDO);
+    rs_image base = {0}, painted = {0}, hidden = {0};
+    if (!render(&v, &base)) return;
+    uint32_t n = rs_splat_lod_count(face, MAX_SPLATS);
+    rs_makeup_gpu *rec = calloc(n, sizeof *rec);
+    RS_REQUIRE(rec != NULL, "out of memory");
+    // Pure blue at full intensity on every drawn splat; the colour range clamp allows all of 0..1.
+    for (uint32_t i = 0; i < n; i++) rec[i] = (rs_makeup_gpu){.rgb = {0, 0, 255}, .colour_i = 255, .flags = 128};
+    rs_error err = {0};
+    bool ok = RS_CHECK(rs_render_update_makeup(ren, 0, n, rec, &err) == RS_OK, "%s", err.msg);
+    ok = ok && render(&v, &painted);
+    v.hide_makeup = true;
+    ok = ok && render(&v, &hidden);
+    memset(rec, 0, n * sizeof *rec);
+    RS_CHECK(rs_render_update_makeup(ren, 0, n, rec, &err) == RS_OK, "%s", err.msg);
+    free(rec);
+    if (ok) {
+        int x = SIZE / 2, y = SIZE / 2;
+        const uint8_t *p = px(&painted, x, y);
+        RS_CHECK(p[2] > 200 && p[0] < 60, "painted centre pixel is %d %d %d, not blue", p[0], p[1], p[2]);
+        rs_image_metrics m;
+        RS_REQUIRE(rs_image_compare(&base, &hidden, 0, &m, &err) == RS_OK, "%s", err.msg);
+        RS_CHECK(m.max_abs == 0, "hide_makeup differs from the base by %d", m.max_abs);
+    }
+    rs_image_free(&base);
+    rs_image_free(&painted);
+    rs_image_free(&hidden);
+}
+
+static void test_debug_views_show_what_they_name(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_NORMALS);
+    rs_image nrm = {0}, lod = {0};
+    if (!render(&v, &nrm)) return;
+    float tip[2];
+    RS_REQUIRE(rs_render_project(ren, &v, face->pos[nose_tip()], tip), "nose tip behind the camera");
+    // At the nose tip the surface faces the camera: view-space normal ~ (0, 0, 1) -> (128, 128, 255).
+    const uint8_t *p = px(&nrm, (int)tip[0], (int)tip[1]);
+    RS_CHECK(p[2] > 220 && abs(p[0] - 128) < 60 && abs(p[1] - 128) < 60, "nose tip normal colour %d %d %d", p[0],
+             p[1], p[2]);
+    v.mode = RS_MODE_LOD;
+    if (render(&v, &lod) && face->hdr.lod_count > 1) {
+        // Several LOD levels are drawn, so several colours appear.
+        int seen_red = 0, seen_other = 0;
+        for (int y = 0; y < SIZE; y++)
+            for (int x = 0; x < SIZE; x++) {
+                if (is_background(&lod, x, y)) continue;
+                const uint8_t *q = px(&lod, x, y);
+                if (q[0] > 200 && q[1] < 80 && q[2] < 80) seen_red++;
+                else seen_other++;
+            }
+        RS_CHECK(seen_red > 0 && seen_other > 0, "LOD view: %d coarsest-level pixels, %d others", seen_red, seen_other);
+    }
+    rs_image_free(&nrm);
+    rs_image_free(&lod);
+}
+
+int main(int argc, char **argv)
+{
+    rs_test_init(argc, argv);
+    rs_error err = {0};
+    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
+        printf("FAIL - render_gl_context: %s\n", err.msg);
+        return 1;
+    }
+    const char *path = getenv("RS_TEST_FACE");
+    if (!path || !*path) path = "assets/face.rsf";
+    if (rs_splat_load(path, &face, &err) != RS_OK) {
+        snprintf(face_why, sizeof face_why, "no test face: %s", err.msg);
+    } else if (rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &ren, &err) != RS_OK) {
+        printf("FAIL - render_create: %s\n", err.msg);
+        rs_splat_destroy(face);
+        rs_gl_destroy(gl);
+        return 1;
+    }
+    RS_RUN(test_visibility_leaves_no_holes_inside_silhouette);
+    RS_RUN(test_coarse_lod_and_side_view_have_no_holes);
+    RS_RUN(test_points_and_quads_give_the_same_image);
+    RS_RUN(test_shadow_darkens_region_under_nose);
+    RS_RUN(test_shadow_map_has_no_acne_on_lit_forehead);
+    RS_RUN(test_diffusion_softens_terminator_and_red_reaches_farther);
+    RS_RUN(test_diffusion_conserves_energy_on_average);
+    RS_RUN(test_specular_energy_doubles_with_rho_s);
+    RS_RUN(test_nose_specular_brighter_than_cheek_at_matching_geometry);
+    RS_RUN(test_composite_is_albedo_times_diffuse_plus_specular);
+    RS_RUN(test_rgba8_fallback_is_close_to_float_targets);
+    RS_RUN(test_golden_albedo);
+    RS_RUN(test_golden_diffuse);
+    RS_RUN(test_golden_full);
+    RS_RUN(test_pick_returns_visible_splat_under_pixel_and_false_on_background);
+    RS_RUN(test_bad_views_are_refused_with_a_message);
+    RS_RUN(test_frame_restores_gl_state);
+    RS_RUN(test_makeup_records_reach_the_attribute_pass);
+    RS_RUN(test_debug_views_show_what_they_name);
+    rs_render_destroy(ren);
+    rs_splat_destroy(face);
+    rs_gl_destroy(gl);
+    return rs_test_finish();
+}
