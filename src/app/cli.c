@@ -38,6 +38,8 @@ static const opt opts[] = {
     {"--exposure", OPT_FLOAT, "X", "linear exposure before sRGB encoding (default 1)", 0.01f, 100},
     {"--background", OPT_RGB, "R,G,B", "background colour, sRGB 0..1", 0, 1},
     {"--no-shadows", OPT_FLAG, NULL, "disable the shadow map", 0, 0},
+    {"--specular-scale", OPT_FLOAT, "X", "multiply every rho_s (1 = Weyrich's measured skin; 2 = oily skin)", 0.01f, 10},
+    {"--ambient", OPT_FLOAT, "X", "uniform sky light added to the irradiance (default 0.05)", 0, 10},
     {"--max-splats", OPT_INT, "N", "draw at most N splats (an LOD prefix)", 1, 2e9f},
     {"--kernels", OPT_INT, "K", "mobile pipeline: number of Gaussians (2..4, default 3)", 2, 4},
     {"--prim", OPT_ENUM, "P", "auto|points|quads: splat primitive", 0, 0},
@@ -135,6 +137,8 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--fill-intensity")) w->fill.intensity = f;
     else if (!strcmp(n, "--exposure")) w->exposure = f;
     else if (!strcmp(n, "--no-shadows")) w->no_shadows = true;
+    else if (!strcmp(n, "--specular-scale")) w->rho_s_scale = f;
+    else if (!strcmp(n, "--ambient")) w->ambient = f;
     else if (!strcmp(n, "--max-splats")) w->max_splats = (uint32_t)f;
     else if (!strcmp(n, "--kernels")) w->kernel_count = (int)f;
     else if (!strcmp(n, "--strokes")) c->strokes = v;
