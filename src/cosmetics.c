@@ -40,8 +40,10 @@ static const rs_cosmetic presets[] = {
     {"highlighter", RS_COSMETIC_HIGHLIGHTER, {250, 236, 214}, 0.40f, 0.50f, 1.00f, 0.21f, 0.45f, 0.12f, 0.50f},
     // Lipsticks: opaque, small brush. Matte red: rough, low specular. Satin pink: about the lips' own
     // measured finish (m 0.27-0.30, rho_s 0.26-0.31), so colour changes but the sheen stays.
-    {"lipstick_matte", RS_COSMETIC_LIPSTICK, {168, 36, 54}, 0.80f, 1.00f, 1.00f, 0.42f, 0.09f, 0.08f, 0.80f},
-    {"lipstick_satin", RS_COSMETIC_LIPSTICK, {204, 78, 118}, 0.70f, 1.00f, 1.00f, 0.27f, 0.28f, 0.08f, 0.80f},
+    // Lipsticks are the most opaque products: full coverage and high pigment load, so two passes cover
+    // the lips (I ~ 0.94 at the brush centre) while the lips' texture still shows through.
+    {"lipstick_matte", RS_COSMETIC_LIPSTICK, {168, 36, 54}, 0.95f, 1.00f, 1.00f, 0.42f, 0.09f, 0.08f, 1.00f},
+    {"lipstick_satin", RS_COSMETIC_LIPSTICK, {204, 78, 118}, 0.90f, 1.00f, 1.00f, 0.27f, 0.28f, 0.08f, 1.00f},
     // Lip gloss: colourless (colour weight 0: the record's colour intensity stays 0), a clear wet coat:
     // smooth (m 0.14) and about twice the lips' specular (rho_s 0.55).
     {"lip_gloss", RS_COSMETIC_LIP_GLOSS, {255, 255, 255}, 0.60f, 0.00f, 1.00f, 0.14f, 0.55f, 0.08f, 0.80f},

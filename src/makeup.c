@@ -14,7 +14,7 @@
 //   makeup. We let the brush footprint carry every term, I = I_G (0.3 + 0.3 I_M + 0.3 I_F), which is the
 //   paper's value at the brush centre and fades smoothly to 0 at the rim. I_G is a Gaussian with sigma
 //   = radius / 2, shifted and rescaled to reach exactly 0 at the radius; I_M is the cosmetic's material
-//   weight; I_F = 1 - exp(-touches / 2) with touches = the number of strokes that have reached the
+//   weight; I_F = 1 - exp(-touches / K), K = 1 (RS_MAKEUP_TOUCH_K), with touches = the number of strokes that have reached the
 //   splat (counting strokes, not stamps, keeps the result independent of stamp spacing). The stamp's
 //   intensity is then scaled by opacity x pressure map.
 //

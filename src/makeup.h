@@ -58,7 +58,7 @@ typedef enum rs_makeup_pressure {
 } rs_makeup_pressure;
 
 #define RS_MAKEUP_FACING_MIN 0.2f   // facing test: dot(normal, view_dir) must exceed this
-#define RS_MAKEUP_TOUCH_K 2.0f      // I_F = 1 - exp(-touches / K), touches = strokes that reached the splat
+#define RS_MAKEUP_TOUCH_K 1.0f      // I_F = 1 - exp(-touches / K), touches = strokes that reached the splat
 #define RS_MAKEUP_SIGMA_REL 0.5f    // I_G Gaussian sigma = 0.5 * brush radius (shifted to reach 0 at the rim)
 
 typedef struct rs_makeup_desc {

@@ -152,7 +152,9 @@ static void test_eq3_intensity_is_weighted_sum_at_brush_centre(void)
         prev = g;
     }
     RS_CHECK(rs_makeup_touch_weight(0) == 0.0f, "I_F(0) = 0");
-    RS_CHECK(fabsf(rs_makeup_touch_weight(2) - (1.0f - expf(-1.0f))) < 1e-6f, "I_F(2) = 1 - e^-1 (k = 2)");
+    RS_CHECK(fabsf(rs_makeup_touch_weight(2) - (1.0f - expf(-2.0f / RS_MAKEUP_TOUCH_K))) < 1e-6f,
+             "I_F(2) = 1 - e^(-2/K)");
+    RS_CHECK(fabsf(rs_makeup_touch_weight(1) - (1.0f - expf(-1.0f))) < 1e-6f, "I_F(1) = 1 - e^-1 (K = 1)");
     RS_CHECK(rs_makeup_touch_weight(3) > rs_makeup_touch_weight(2), "I_F grows with touches");
 }
 
