@@ -95,20 +95,20 @@ static void update_spacing(rs_paint *p, const float pos[3])
     if (isfinite(ppu) && ppu > 0.0f) rs_input_set_spacing(&p->input, p->spacing_rel * radius * ppu);
 }
 
-static bool pick(rs_paint *p, float x, float y, uint32_t *idx)
+static bool pick(rs_paint *p, float x, float y, uint32_t *idx, float hit[3])
 {
-    return p->picker.pick(p->picker.user, x, y, idx) && *idx < rs_makeup_count(p->mk);
+    return p->picker.pick(p->picker.user, x, y, idx, hit) && *idx < rs_makeup_count(p->mk);
 }
 
 static rs_result stamp_at(rs_paint *p, const rs_input_stamp *s, rs_paint_result *res, rs_error *err)
 {
     uint32_t idx;
-    if (!pick(p, s->x_px, s->y_px, &idx)) {
+    float pos[3];
+    if (!pick(p, s->x_px, s->y_px, &idx, pos)) {
         res->misses++;  // background: stamp nothing
         return RS_OK;
     }
     const rs_splat_cloud *cloud = rs_makeup_cloud(p->mk);
-    const float *pos = cloud->pos[idx];
     const rs_paint_brush *b = &p->stroke_brush;
     rs_makeup_stamp_desc d = {
         .pos = {pos[0], pos[1], pos[2]},
@@ -148,8 +148,9 @@ rs_result rs_paint_feed(rs_paint *p, const rs_input_event *ev, rs_paint_result *
     if (starts) {
         p->stroke_brush = resolve_brush(&p->brush);
         uint32_t idx;
-        if (isfinite(ev->x_px) && isfinite(ev->y_px) && pick(p, ev->x_px, ev->y_px, &idx))
-            update_spacing(p, rs_makeup_cloud(p->mk)->pos[idx]);
+        float hit[3];
+        if (isfinite(ev->x_px) && isfinite(ev->y_px) && pick(p, ev->x_px, ev->y_px, &idx, hit))
+            update_spacing(p, hit);
     }
     rs_input_output out;
     rs_input_feed(&p->input, ev, &out);

@@ -25,8 +25,9 @@
 // Implemented by the renderer for the current camera and frame.
 typedef struct rs_paint_picker {
     void *user;
-    // Splat index visible at the pixel (ID buffer), false on background.
-    bool (*pick)(void *user, float x_px, float y_px, uint32_t *splat_index);
+    // Splat index visible at the pixel (ID buffer) and the surface point under the pixel (the stamp
+    // centre); false on background.
+    bool (*pick)(void *user, float x_px, float y_px, uint32_t *splat_index, float hit[3]);
     // On-screen pixels per model unit at a model-space point (for stamp spacing).
     float (*pixels_per_unit)(void *user, const float pos[3]);
     // Unit vector from pos TOWARDS the eye (for the facing test); zero to disable the test.

@@ -130,10 +130,10 @@ typedef struct picker_ctx {
     rs_view view;
 } picker_ctx;
 
-static bool pick_cb(void *user, float x, float y, uint32_t *idx)
+static bool pick_cb(void *user, float x, float y, uint32_t *idx, float hit[3])
 {
     picker_ctx *c = user;
-    return rs_render_pick(ren, &c->view, x, y, idx);
+    return rs_render_pick(ren, &c->view, x, y, idx, hit);
 }
 
 static float ppu_cb(void *user, const float pos[3])
@@ -438,7 +438,7 @@ static void check_landing(const char *file, const char *from, const char *to, in
         double off = hypot(got[0] - want[0], got[1] - want[1]), frac = all > 0 ? on / all : 0;
         uint32_t idx = 0;
         rs_view pv = pick_view();
-        RS_CHECK(rs_render_pick(ren, &pv, (float)want[0], (float)want[1], &idx), "path centroid misses the face");
+        RS_CHECK(rs_render_pick(ren, &pv, (float)want[0], (float)want[1], &idx, NULL), "path centroid misses the face");
         double radius_px = rs_makeup_brush_radius(&face->hdr, doc->strokes[0].brush.size_rel) *
                            rs_render_pixels_per_unit(ren, &v, face->pos[idx]);
         double allowed = fmax(2.0, CENTROID_RADII * radius_px);

@@ -524,7 +524,7 @@ static void test_pick_returns_visible_splat_under_pixel_and_false_on_background(
     float p[2];
     RS_REQUIRE(rs_render_project(ren, &v, face->pos[tip], p), "nose tip behind the camera");
     uint32_t got = UINT32_MAX;
-    RS_REQUIRE(rs_render_pick(ren, &v, p[0], p[1], &got), "no splat at the nose tip (%.1f, %.1f)", p[0], p[1]);
+    RS_REQUIRE(rs_render_pick(ren, &v, p[0], p[1], &got, NULL), "no splat at the nose tip (%.1f, %.1f)", p[0], p[1]);
     uint32_t n = rs_splat_lod_count(face, MAX_SPLATS);
     RS_CHECK(got < n, "picked splat %u outside the drawn prefix of %u", got, n);
     // The picked disk covers the clicked pixel: its projected centre is within its projected radius.
@@ -542,9 +542,31 @@ static void test_pick_returns_visible_splat_under_pixel_and_false_on_background(
     RS_CHECK(fabsf(along) < 4.0f * face->radius[got] * rs_splat_lod_radius_scale(face, n), "picked splat %.4f units "
              "off the front surface", along);
     uint32_t none = 7;
-    RS_CHECK(!rs_render_pick(ren, &v, 2.0f, 2.0f, &none) && none == 7, "corner pixel picked splat %u", none);
-    RS_CHECK(!rs_render_pick(ren, &v, -1.0f, 10.0f, &none) && !rs_render_pick(ren, &v, 10.0f, (float)SIZE, &none),
+    RS_CHECK(!rs_render_pick(ren, &v, 2.0f, 2.0f, &none, NULL) && none == 7, "corner pixel picked splat %u", none);
+    RS_CHECK(!rs_render_pick(ren, &v, -1.0f, 10.0f, &none, NULL) &&
+                 !rs_render_pick(ren, &v, 10.0f, (float)SIZE, &none, NULL),
              "a pixel outside the view picked something");
+}
+
+// The stamp centre is the surface point under the pixel: it projects back onto the clicked pixel,
+// where the picked splat's centre may be pixels away at coarse LOD.
+static void test_pick_hit_point_projects_back_to_the_clicked_pixel(void)
+{
+    if (!need_face()) return;
+    rs_view v = test_view(RS_MODE_FULL);
+    float worst = 0;
+    int picked = 0;
+    for (int y = SIZE / 4; y < 3 * SIZE / 4; y += SIZE / 16)
+        for (int x = SIZE / 4; x < 3 * SIZE / 4; x += SIZE / 16) {
+            uint32_t idx;
+            float hit[3], q[2];
+            if (!rs_render_pick(ren, &v, (float)x, (float)y, &idx, hit)) continue;
+            picked++;
+            RS_REQUIRE(rs_render_project(ren, &v, hit, q), "hit point behind the camera");
+            worst = fmaxf(worst, hypotf(q[0] - ((float)x + 0.5f), q[1] - ((float)y + 0.5f)));
+        }
+    RS_CHECK(picked > 30, "only %d of the central pixels hit the face", picked);
+    RS_CHECK(worst < 0.05f, "hit point projects %.3f px from the clicked pixel centre", worst);
 }
 
 // ---- API behaviour ----
@@ -683,6 +705,7 @@ int main(int argc, char **argv)
     RS_RUN(test_golden_diffuse);
     RS_RUN(test_golden_full);
     RS_RUN(test_pick_returns_visible_splat_under_pixel_and_false_on_background);
+    RS_RUN(test_pick_hit_point_projects_back_to_the_clicked_pixel);
     RS_RUN(test_bad_views_are_refused_with_a_message);
     RS_RUN(test_frame_restores_gl_state);
     RS_RUN(test_makeup_records_reach_the_attribute_pass);

@@ -245,11 +245,12 @@ typedef struct mock {
     float half;  // plane half-size; outside is background
 } mock;
 
-static bool mock_pick(void *user, float x, float y, uint32_t *idx)
+static bool mock_pick(void *user, float x, float y, uint32_t *idx, float hit[3])
 {
     mock *m = user;
     float p[3] = {x / 256.0f - 0.5f, 0.5f - y / 256.0f, 0.0f};
     if (fabsf(p[0]) > m->half || fabsf(p[1]) > m->half) return false;
+    hit[0] = p[0], hit[1] = p[1], hit[2] = p[2];
     return rs_makeup_nearest(m->mk, p, 0.02f, idx);
 }
 

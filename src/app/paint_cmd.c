@@ -12,10 +12,10 @@ typedef struct picker_ctx {
     rs_view view;
 } picker_ctx;
 
-static bool pick_cb(void *user, float x, float y, uint32_t *idx)
+static bool pick_cb(void *user, float x, float y, uint32_t *idx, float hit[3])
 {
     picker_ctx *c = user;
-    return rs_render_pick(c->ren, &c->view, x, y, idx);
+    return rs_render_pick(c->ren, &c->view, x, y, idx, hit);
 }
 
 static float ppu_cb(void *user, const float pos[3])

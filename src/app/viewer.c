@@ -123,10 +123,10 @@ static float slider_to_size(float v) { return SIZE_MIN_REL * powf(SIZE_MAX_REL /
 
 // Pointer positions are framebuffer pixels; the picture may be rendered at a lower resolution
 // (render_scale) while the user interacts.
-bool vw_pick(void *user, float x, float y, uint32_t *idx)
+bool vw_pick(void *user, float x, float y, uint32_t *idx, float hit[3])
 {
     vw_viewer *v = user;
-    return rs_render_pick(v->ren, &v->view, x * v->render_scale, y * v->render_scale, idx);
+    return rs_render_pick(v->ren, &v->view, x * v->render_scale, y * v->render_scale, idx, hit);
 }
 
 float vw_pixels_per_unit(void *user, const float pos[3])

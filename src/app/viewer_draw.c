@@ -75,9 +75,10 @@ static void draw_brush_ring(vw_viewer *v)
     if (v->ring_moved && !v->scene_owns[0]) {
         // One pick per frame at most, and only when the cursor moved.
         uint32_t idx;
+        float hit[3];
         v->ring_valid = false;
-        if (vw_pick(v, v->mx, v->my, &idx)) {
-            float r = rs_paint_radius(v->paint) * vw_pixels_per_unit(v, v->cloud->pos[idx]);
+        if (vw_pick(v, v->mx, v->my, &idx, hit)) {
+            float r = rs_paint_radius(v->paint) * vw_pixels_per_unit(v, hit);
             if (isfinite(r) && r > 0) v->ring_px = r, v->ring_valid = true;
         }
         v->ring_moved = false;

@@ -243,7 +243,7 @@ double vw_now(void);
 void vw_toast(vw_viewer *v, bool error, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
 float vw_size_to_slider(float size_rel);
 // The picker on the picture as shown: framebuffer pixels in, whatever resolution it was rendered at.
-bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index);
+bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index, float hit[3]);
 float vw_pixels_per_unit(void *viewer, const float pos[3]);
 
 // viewer_draw.c

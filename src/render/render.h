@@ -76,7 +76,9 @@ typedef struct rs_view {
     bool hide_makeup;           // render the bare face (before/after split)
     float rho_s_scale;          // multiplies every rho_s (tests, paper Fig. 11); 0 means 1
     uint32_t max_splats;        // cap on the LOD prefix drawn (0: pipeline decides)
-    int kernel_count;           // mobile pipeline: K Gaussians (0: default)
+    int kernel_count;           // mobile pipeline: K Gaussians (0: default, 3)
+    float lod_density;          // mobile pipeline: main passes draw the LOD prefix nearest to this many
+                                // splats per pixel of the face's screen area (0: default, 1)
     rs_splat_prim prim;         // primitive choice (AUTO by caps)
     float ambient;              // uniform sky irradiance added to every splat (linear, unshadowed); 0: none
     bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)
@@ -115,6 +117,7 @@ typedef struct rs_render_stats {
     double stage_ms[RS_STAGE_COUNT]; // last frame, glFinish-timed (desc.time_stages); 0 otherwise
     double frame_ms;                 // last frame's rs_render_frame wall time (glFinish-timed if time_stages)
     double level_ms[6];              // stage 4 per drawn Gaussian level, same timing (kernel_count entries)
+    float face_pixels;               // mobile: the face's estimated screen area that chose the LOD prefix
 } rs_render_stats;
 
 rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_error *err);
@@ -129,8 +132,10 @@ rs_result rs_render_read(rs_renderer *r, rs_image *out, rs_error *err);
 // rs_render_frame + rs_render_read.
 rs_result rs_render_image(rs_renderer *r, const rs_view *view, rs_image *out, rs_error *err);
 
-// ID buffer: the visible splat under pixel (x, y) (top-left origin) for this view. False on background.
-bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t *splat_index);
+// ID buffer: the visible splat under pixel (x, y) (top-left origin) for this view, and (hit, may be NULL)
+// the point on that splat's disk under the pixel. False on background.
+bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t *splat_index,
+                    float hit[3]);
 // Pixels per model unit at a model-space point for this view (brush size on screen).
 float rs_render_pixels_per_unit(const rs_renderer *r, const rs_view *view, const float pos[3]);
 // Unit vector from a model-space point towards the camera.
@@ -147,5 +152,10 @@ rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count
 void rs_render_set_makeup_uniforms(rs_renderer *r, const rs_makeup_uniforms *u);
 
 rs_render_stats rs_render_get_stats(const rs_renderer *r);
+
+// Splats the main passes would draw for this view: the max_splats cap, and in the mobile pipeline the
+// LOD prefix chosen by lod_density from the face's screen area (cheap: a few thousand dot products).
+// The viewer's adaptive ladder starts from it and coarsens from there while interacting.
+uint32_t rs_render_auto_splats(const rs_renderer *r, const rs_view *view);
 
 #endif

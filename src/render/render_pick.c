@@ -4,6 +4,7 @@
 // geometry (size, camera, LOD, primitive) stays the same, so a stroke of many stamps renders it once.
 #include "render/render_internal.h"
 
+#include <math.h>
 #include <string.h>
 
 #define CULL_COS -0.25f
@@ -23,7 +24,7 @@ static bool same_geometry(const rs_view *a, const rs_view *b)
     return a->width == b->width && a->height == b->height && a->yaw_deg == b->yaw_deg &&
            a->pitch_deg == b->pitch_deg && a->zoom == b->zoom && a->fov_deg == b->fov_deg &&
            a->pan[0] == b->pan[0] && a->pan[1] == b->pan[1] && a->max_splats == b->max_splats &&
-           a->prim == b->prim && a->pipeline == b->pipeline;
+           a->prim == b->prim && a->pipeline == b->pipeline && a->lod_density == b->lod_density;
 }
 
 static bool ensure_pick_targets(rs_renderer *r, int w, int h)
@@ -82,7 +83,37 @@ static bool render_ids(rs_renderer *r, const rs_view *view)
     return true;
 }
 
-bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t *splat_index)
+// Where the eye ray through pixel (x, y) meets splat i's plane: the stamp centre must be the surface
+// point under the finger, not the splat's centre, which can lie a splat radius (pixels, at coarse
+// LOD) away. Falls back to the centre for grazing rays.
+static void hit_point(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t i, float hit[3])
+{
+    const rs_splat_cloud *c = r->cloud;
+    const float *ctr = c->pos[i], *n = c->normal[i];
+    hit[0] = ctr[0], hit[1] = ctr[1], hit[2] = ctr[2];
+    rs_frame f;
+    rs_render_frame_setup(r, view, &f);
+    mat4 vp, inv;
+    glm_mat4_mul(f.cam.proj, f.cam.view, vp);
+    glm_mat4_inv(vp, inv);
+    vec4 ndc = {2.0f * x_px / (float)f.cam.width - 1.0f, 1.0f - 2.0f * y_px / (float)f.cam.height, 1.0f, 1.0f}, far;
+    glm_mat4_mulv(inv, ndc, far);
+    if (fabsf(far[3]) < 1e-12f) return;
+    vec3 o = {f.cam.eye[0], f.cam.eye[1], f.cam.eye[2]};
+    vec3 d = {far[0] / far[3] - o[0], far[1] / far[3] - o[1], far[2] / far[3] - o[2]};
+    glm_vec3_normalize(d);
+    float dn = glm_vec3_dot(d, (float *)n);
+    if (fabsf(dn) < 0.05f) return;
+    vec3 co = {ctr[0] - o[0], ctr[1] - o[1], ctr[2] - o[2]};
+    float t = glm_vec3_dot(co, (float *)n) / dn;
+    vec3 q = {o[0] + t * d[0], o[1] + t * d[1], o[2] + t * d[2]};
+    // The ID pass draws disks slightly enlarged; never move further than two radii from the centre.
+    float lim = 2.0f * c->radius[i] * f.radius_scale;
+    if (!(glm_vec3_distance(q, (float *)ctr) <= lim)) return;
+    hit[0] = q[0], hit[1] = q[1], hit[2] = q[2];
+}
+
+bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px, uint32_t *splat_index, float hit[3])
 {
     if (!view || view->width <= 0 || view->height <= 0 || view->width > r->caps.max_texture_size ||
         view->height > r->caps.max_texture_size)
@@ -98,5 +129,6 @@ bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px,
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (glGetError() != GL_NO_ERROR || id[0] == 0 || id[0] > r->cloud->hdr.count) return false;
     *splat_index = id[0] - 1;
+    if (hit) hit_point(r, view, x_px + 0.5f, y_px + 0.5f, *splat_index, hit);
     return true;
 }
