@@ -21,8 +21,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     size_t len = 0;
     if (rs_strokes_write_memory(doc, &text, &len, &err) != RS_OK) __builtin_trap();
     if (rs_strokes_parse(text, len, &back, &err) != RS_OK) __builtin_trap();
+    // (memcmp only when there are samples: both arrays may be NULL, and memcmp(NULL, NULL, 0) is UB.)
     if (back->count != doc->count || back->sample_count != doc->sample_count ||
-        memcmp(back->samples, doc->samples, doc->sample_count * sizeof *doc->samples) != 0)
+        (doc->sample_count > 0 && memcmp(back->samples, doc->samples, doc->sample_count * sizeof *doc->samples) != 0))
         __builtin_trap();
     for (uint32_t i = 0; i < doc->count; i++)
         if (!rs_cosmetic_equal(&doc->strokes[i].cosmetic, &back->strokes[i].cosmetic)) __builtin_trap();

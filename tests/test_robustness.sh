@@ -1,0 +1,308 @@
+#!/bin/sh
+# test_robustness.sh — the bad-input table (docs/robustness.md): every hostile input class given to the
+# real programs (rouge render, rouge view, rouge-pack, rouge-imgdiff, the shader embedder) gets ONE line
+# on stderr naming the problem, a non-zero exit status (no crash: no signal), and leaves no output file
+# and no temp file behind. Complements tests/test_cli.sh and tests/test_pack_cli.sh (usage errors there
+# are not repeated here) and the loaders' unit tests (every truncation and bit flip of small files).
+#
+# Usage: sh tests/test_robustness.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
+# RS_ROBUSTNESS_TABLE=FILE also writes the table rows (input | command | what it gets) to FILE: that is
+# how docs/robustness.md is made.
+build=${1:-build}
+[ $# -gt 0 ] && shift
+filters="$*"
+rouge="$build/rouge"
+pack="$build/rouge-pack"
+imgdiff="$build/rouge-imgdiff"
+embed="$build/embed_shaders"
+bad=tests/fixtures/bad
+face=assets/face.rsf
+tiny=tests/fixtures/rsf/tiny_v1.rsf
+table=${RS_ROBUSTNESS_TABLE:-}
+tmp=$(mktemp -d)
+trap 'chmod -R u+w "$tmp" 2>/dev/null; rm -rf "$tmp"' EXIT
+[ -n "$table" ] && : >"$table"
+
+selected() {
+    [ -z "$filters" ] && return 0
+    for f in $filters; do
+        case "$1" in *"$f"*) return 0 ;; esac
+    done
+    return 1
+}
+
+# bad_input NAME WHAT WANT_RC PATTERN OUTPUT CMD...
+#   Runs CMD; wants exit WANT_RC, exactly one stderr line containing PATTERN, and neither OUTPUT nor any
+#   OUTPUT.tmp* left behind ("-" when the command writes no file). WHAT describes the input for the table.
+bad_input() {
+    name=robust_$1 what=$2 want=$3 pat=$4 output=$5
+    shift 5
+    selected "$name" || return 0
+    case $1 in render | env) prog=$rouge ;; *) prog=$1 ;; esac
+    if [ ! -x "$prog" ]; then
+        echo "skip - $name: $prog not built"
+        return 0
+    fi
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    rc=$?
+    lines=$(wc -l <"$tmp/err")
+    why=""
+    if [ "$rc" -ge 128 ]; then
+        why="killed by signal $((rc - 128))"
+    elif [ "$rc" -ne "$want" ]; then
+        why="exit $rc, wanted $want"
+    elif [ "$lines" -ne 1 ]; then
+        why="stderr has $lines lines, wanted one"
+    elif ! grep -qF -- "$pat" "$tmp/err"; then
+        why="stderr lacks '$pat'"
+    elif [ "$output" != - ] && { [ -e "$output" ] || ls "$output".tmp* >/dev/null 2>&1; }; then
+        why="left $output (or a temp file) behind"
+    fi
+    if [ -n "$why" ]; then
+        echo "FAIL - $name: $why: $(head -c 300 "$tmp/err")"
+    else
+        echo "ok - $name"
+    fi
+    if [ -n "$table" ]; then
+        # The command as a reader would type it: scratch paths shortened, the build dir as "build".
+        cmd=$(printf '%s ' "$@" | sed -e "s#$tmp/#/tmp/#g" -e "s#^render #build/rouge render #" \
+            -e "s#\(^\| \)$build/#\1build/#g" -e 's/ $//')
+        msg=$(head -n 1 "$tmp/err" | sed -e "s#$tmp/#/tmp/#g" -e 's/|/\\|/g')
+        printf '| %s | `%s` | exit %s: `%s` |\n' "$what" "$cmd" "$rc" "$msg" >>"$table"
+    fi
+}
+
+render() {  # the smallest render that still loads the whole face and makes a GL context
+    "$rouge" render "$@" --size 32x32 --max-splats 2000
+}
+
+# ---- .rsf: truncated at every section (tiny_v1.rsf: header 0..624, records 624..688, CRC 688..692) ----
+for cut in 0:empty 3:magic 10:fixed_header 150:lod_table 400:region_table 600:notes 620:padding \
+    650:payload 690:crc; do
+    n=${cut%%:*} section=${cut#*:}
+    head -c "$n" "$tiny" >"$tmp/cut_$section.rsf"
+    what=".rsf truncated in the $(echo "$section" | tr _ ' ') (first $n of 692 bytes)"
+    [ "$n" = 0 ] && what=".rsf: empty file"
+    bad_input "rsf_truncated_in_$section" "$what" 1 \
+        "cut_$section.rsf:" "$tmp/o.png" "$rouge" render "$tmp/cut_$section.rsf" -o "$tmp/o.png"
+done
+
+# ---- .rsf: one damaged field each, CRC recomputed (tests/fixtures/bad/make_bad.py) ----
+while IFS='|' read -r file pat what; do
+    bad_input "${file%.rsf}" ".rsf: $what" 1 "$pat" "$tmp/o.png" "$rouge" render "$bad/$file" -o "$tmp/o.png"
+done <<'EOF'
+rsf_wrong_magic.rsf|magic:|wrong magic "RSX\0"
+rsf_version_2.rsf|unsupported version 2|version 2
+rsf_header_size_wrong.rsf|header_size:|header_size disagrees with notes_len
+rsf_flags_set.rsf|flags:|reserved flags set
+rsf_count_zero.rsf|count:|0 splats
+rsf_count_past_end.rsf|count:|count larger than the file holds
+rsf_nan_bbox.rsf|bbox_min[0]:|NaN in the bounding box
+rsf_inverted_bbox.rsf|bbox_max[0]:|bbox max below min
+rsf_negative_radius.rsf|radius_min:|negative radius range
+rsf_inf_mm_per_unit.rsf|mm_per_unit:|infinite scale
+rsf_forward_not_unit.rsf|forward:|face frame not unit length
+rsf_negative_face_height.rsf|face_height:|negative face height
+rsf_lod_count_huge.rsf|lod_count:|1000 LOD levels
+rsf_lods_ascending.rsf|lods[1]:|LOD table not descending
+rsf_region_count_huge.rsf|region_count:|200 regions
+rsf_region_m_nan.rsf|regions[0].m:|NaN roughness
+rsf_region_rho_negative.rsf|regions[1].rho_s:|negative rho_s
+rsf_notes_len_huge.rsf|notes_len:|notes_len 0xFFFFFFF0
+rsf_notes_bad_utf8.rsf|notes:|notes not UTF-8
+rsf_record_flags.rsf|splat 0:|reserved record bits set
+rsf_trailing_bytes.rsf|after the CRC|16 bytes after the CRC
+EOF
+bad_input rsf_bad_crc ".rsf: one payload bit flipped (CRC kept)" 1 "crc: stored" "$tmp/o.png" \
+    "$rouge" render tests/fixtures/rsf/bad_crc.rsf -o "$tmp/o.png"
+bad_input rsf_huge_count ".rsf: count 0xFFFFFFFF (CRC recomputed)" 1 "count:" "$tmp/o.png" \
+    "$rouge" render tests/fixtures/rsf/bad_huge_count.rsf -o "$tmp/o.png"
+bad_input rsf_region_out_of_table ".rsf: a splat's region 9 of 5" 1 "splat 1" "$tmp/o.png" \
+    "$rouge" render tests/fixtures/rsf/bad_region.rsf -o "$tmp/o.png"
+bad_input rsf_ply_given_as_face "a PLY given as the face" 1 "magic:" "$tmp/o.png" \
+    "$rouge" render tests/fixtures/ply/points_le.ply -o "$tmp/o.png"
+bad_input rsf_info_truncated "rouge-pack --info on a truncated .rsf" 1 "cut_payload.rsf:" - \
+    "$pack" --info "$tmp/cut_payload.rsf"
+
+# ---- PLY (rouge-pack) ----
+while IFS='|' read -r file pat what; do
+    bad_input "${file%.ply}" "PLY: $what" 1 "$pat" "$tmp/o.rsf" "$pack" "$bad/$file" -o "$tmp/o.rsf"
+done <<'EOF'
+ply_wrong_magic.ply|not a PLY file|first line "plx"
+ply_unknown_format.ply|unknown format|format binary_middle_endian
+ply_unknown_type.ply|unknown type 'float128'|property type float128
+ply_negative_count.ply|count '-2'|element vertex -2
+ply_no_end_header.ply|header keyword|no end_header
+ply_missing_z.ply|incomplete position|no z property
+ply_zero_vertices.ply|no vertices|0 vertices
+ply_nan_coordinate.ply|NaN|a NaN coordinate (ASCII)
+ply_inf_coordinate.ply|infinite|an inf coordinate (ASCII)
+ply_huge_double.ply|beyond float range|a double beyond float range (1e300)
+ply_text_in_number.ply|not a number|text where a number belongs
+ply_binary_short_body.ply|do not fit|binary body shorter than the vertex count
+EOF
+bad_input ply_list_count_negative "PLY: face list count -3 (uchar)" 1 "out of range for uchar" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/bad_list_count.ply -o "$tmp/o.rsf"
+bad_input ply_face_index_out_of_range "PLY: face vertex index past the vertex count" 1 "vertex index 7" \
+    "$tmp/o.rsf" "$pack" tests/fixtures/ply/bad_face_index.ply -o "$tmp/o.rsf"
+: >"$tmp/empty.ply"
+bad_input ply_empty_file "PLY: empty file" 1 "empty.ply" "$tmp/o.rsf" "$pack" "$tmp/empty.ply" -o "$tmp/o.rsf"
+# A 200 kB header line: the reader must cap lines, not buffer without bound or crash.
+{ echo ply; head -c 200000 /dev/zero | tr '\0' a; echo; } >"$tmp/longline.ply"
+bad_input ply_endless_header_line "PLY: a 200 kB header line" 1 "longline.ply" "$tmp/o.rsf" \
+    "$pack" "$tmp/longline.ply" -o "$tmp/o.rsf"
+bad_input ply_dev_zero "/dev/zero as the PLY" 1 "/dev/zero" "$tmp/o.rsf" "$pack" /dev/zero -o "$tmp/o.rsf"
+bad_input ply_directory "a directory as the PLY" 1 "tests/fixtures" "$tmp/o.rsf" \
+    "$pack" tests/fixtures -o "$tmp/o.rsf"
+bad_input pack_texture_truncated_png "--texture: a truncated PNG" 1 "truncated" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture "$bad/png_truncated.png" -o "$tmp/o.rsf"
+bad_input pack_texture_huge_png "--texture: PNG header claiming 10^6 x 10^6 pixels" 1 "1000000x1000000" \
+    "$tmp/o.rsf" "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture "$bad/png_huge_dimensions.png" \
+    -o "$tmp/o.rsf"
+bad_input pack_texture_dev_zero "--texture /dev/zero" 1 "/dev/zero" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture /dev/zero -o "$tmp/o.rsf"
+bad_input pack_region_map_not_png "--region-map: a PLY instead of a PNG" 1 "--region-map" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --region-map tests/fixtures/ply/points_le.ply \
+    -o "$tmp/o.rsf"
+bad_input pack_points_too_many "--points beyond the format's 64 Mi splats" 2 "--points" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 99999999999 -o "$tmp/o.rsf"
+
+# ---- stroke files (rouge render --strokes) ----
+while IFS='|' read -r file pat what; do
+    bad_input "${file%.strokes}" "stroke file: $what" 1 "$pat" "$tmp/o.png" \
+        render "$face" --strokes "$bad/$file" -o "$tmp/o.png"
+done <<'EOF'
+strokes_wrong_magic.strokes|line 1: not a stroke file|wrong magic line
+strokes_version_9.strokes|version '9'|version 9
+strokes_unknown_keyword.strokes|line 6:|unknown keyword inside a stroke
+strokes_nan_sample.strokes|'nan'|NaN pointer position
+strokes_huge_view.strokes|size:|view size 999999999x999999999
+strokes_unknown_cosmetic.strokes|glitter_bomb|unknown cosmetic preset
+strokes_bad_pressure.strokes|pressure:|pressure 7.5
+strokes_sample_outside_stroke.strokes|outside a stroke|sample before 'stroke'
+EOF
+bad_input strokes_dev_zero "/dev/zero as the stroke file" 1 "/dev/zero" "$tmp/o.png" \
+    render "$face" --strokes /dev/zero -o "$tmp/o.png"
+bad_input strokes_directory "a directory as the stroke file" 1 "tests/fixtures" "$tmp/o.png" \
+    render "$face" --strokes tests/fixtures -o "$tmp/o.png"
+bad_input strokes_binary "a PNG as the stroke file" 1 "a_8x8.png" "$tmp/o.png" \
+    render "$face" --strokes tests/fixtures/image/a_8x8.png -o "$tmp/o.png"
+
+# ---- look files (rouge render --look / --save-look) ----
+while IFS='|' read -r file pat what; do
+    bad_input "${file%.look}" "look file: $what" 1 "$pat" "$tmp/o.png" \
+        render "$face" --look "$bad/$file" -o "$tmp/o.png"
+done <<'EOF'
+look_wrong_magic.look|not a look file|wrong magic line
+look_version_9.look|version '9'|version 9
+look_nan_stamp.look|'nan'|NaN stamp position
+look_cosmetic_out_of_range.look|cosmetic index|stamp names cosmetic 7 of 1
+look_unknown_cosmetic.look|glitter_bomb|unknown cosmetic preset
+look_huge_radius.look|radius:|stamp radius 1e30
+look_negative_face_height.look|face:|face height -1
+EOF
+bad_input look_other_face "look file made on a face 19x smaller" 2 "another face" "$tmp/o.png" \
+    render "$face" --look "$bad/look_other_face.look" -o "$tmp/o.png"
+bad_input look_dev_zero "/dev/zero as the look" 1 "/dev/zero" "$tmp/o.png" \
+    render "$face" --look /dev/zero -o "$tmp/o.png"
+bad_input look_save_unwritable "--save-look into a missing directory" 1 "cannot write" "$tmp/o.png" \
+    render "$face" --look tests/fixtures/bad/control_ok.look --save-look "$tmp/none/x.look" -o "$tmp/o.png"
+mkdir -p "$tmp/dir.look"
+bad_input look_save_onto_directory "--save-look onto a directory" 1 "dir.look" "$tmp/o.png" \
+    render "$face" --look tests/fixtures/bad/control_ok.look --save-look "$tmp/dir.look" -o "$tmp/o.png"
+
+# ---- output paths and the environment ----
+mkdir -p "$tmp/dir.png" "$tmp/ro"
+bad_input render_output_is_directory "-o naming a directory" 1 "dir.png" - \
+    render "$face" -o "$tmp/dir.png"
+if [ -d "$tmp/dir.png" ] && ! ls "$tmp"/dir.png.tmp* >/dev/null 2>&1; then :; else
+    echo "FAIL - robust_render_output_is_directory_keeps_it: the directory was replaced or a temp file left"
+fi
+chmod a-w "$tmp/ro"
+if touch "$tmp/ro/probe" 2>/dev/null; then
+    rm -f "$tmp/ro/probe"
+    selected robust_render_output_read_only_dir && echo "skip - robust_render_output_read_only_dir: running as root (permissions not enforced)"
+else
+    bad_input render_output_read_only_dir "-o into a read-only directory" 1 "cannot write" "$tmp/ro/o.png" \
+        render "$face" -o "$tmp/ro/o.png"
+fi
+bad_input render_no_gles3_with_strokes "no GLES 3 (no EGL vendor), painting requested" 1 "GLES 3" "$tmp/o.png" \
+    env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$rouge" render "$face" --strokes \
+    tests/fixtures/strokes/cheek.strokes -o "$tmp/o.png"
+bad_input view_no_display "rouge view with no display (DISPLAY, WAYLAND_DISPLAY unset)" 1 "" - \
+    env -u DISPLAY -u WAYLAND_DISPLAY "$rouge" view "$face"
+bad_input shaders_missing "missing shader directory at build time" 1 "cannot open shader directory" \
+    "$tmp/shaders.c" "$embed" "$tmp/no_shaders" "$tmp/shaders.c"
+mkdir -p "$tmp/sh"
+printf '#include "gone.glsl"\nvoid main() {}\n' >"$tmp/sh/a.frag.glsl"
+bad_input shaders_missing_include "a shader including a missing file" 1 "gone.glsl" "$tmp/shaders.c" \
+    "$embed" "$tmp/sh" "$tmp/shaders.c"
+
+# ---- CLI values (tests/test_cli.sh has unknown/malformed flags; these are well-formed but wrong) ----
+while IFS='|' read -r name pat args; do
+    # shellcheck disable=SC2086
+    bad_input "cli_$name" "option: $args" 2 "$pat" "$tmp/o.png" "$rouge" render "$face" -o "$tmp/o.png" $args
+done <<'EOF'
+kernels_out_of_range|--kernels|--kernels 7
+pipeline_unknown|--pipeline|--pipeline fast
+prim_unknown|--prim|--prim hexagons
+light_colour_two_components|--light-color|--light-color 1,2
+background_nan|--background|--background nan,0,0
+max_splats_zero|--max-splats|--max-splats 0
+yaw_infinite|--yaw|--yaw inf
+size_too_big|--size|--size 99999x10
+size_garbage|--size|--size 64x64x64
+two_faces|unexpected argument|tests/fixtures/rsf/tiny_v1.rsf
+EOF
+bad_input cli_view_with_output "-o given to the viewer" 2 "-o is only for" - "$rouge" view "$face" -o "$tmp/o.png"
+bad_input cli_save_look_alone "--save-look without --look or --strokes" 2 "--save-look" "$tmp/x.look" \
+    render "$face" -o "$tmp/o.png" --save-look "$tmp/x.look"
+
+# ---- rouge-imgdiff (tests/test_imgdiff.sh has missing/non-PNG/size-mismatch) ----
+bad_input imgdiff_truncated_png "rouge-imgdiff: truncated PNG" 2 "truncated" - \
+    "$imgdiff" "$bad/png_truncated.png" tests/fixtures/image/a_8x8.png
+bad_input imgdiff_huge_png "rouge-imgdiff: PNG claiming 10^6 x 10^6 pixels" 2 "larger than" - \
+    "$imgdiff" "$bad/png_huge_dimensions.png" tests/fixtures/image/a_8x8.png
+bad_input imgdiff_dev_zero "rouge-imgdiff: /dev/zero" 2 "/dev/zero" - \
+    "$imgdiff" /dev/zero tests/fixtures/image/a_8x8.png
+
+# ---- inputs that once crashed a fuzz harness: the real programs must refuse them cleanly too ----
+for f in "$bad"/fuzz/ply/*; do
+    [ -f "$f" ] || continue
+    b=$(basename "$f")
+    "$pack" "$f" -o "$tmp/o.rsf" >/dev/null 2>&1
+    rc=$?
+    if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_ply_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_ply_$b"; fi
+    rm -f "$tmp/o.rsf"
+done
+for f in "$bad"/fuzz/rsf/*; do
+    [ -f "$f" ] || continue
+    b=$(basename "$f")
+    "$pack" --info "$f" >/dev/null 2>&1
+    rc=$?
+    if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_rsf_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_rsf_$b"; fi
+done
+for kind in strokes look; do
+    for f in "$bad/fuzz/$kind"/*; do
+        [ -f "$f" ] || continue
+        b=$(basename "$f")
+        selected "robust_fuzz_${kind}_$b" || continue
+        [ -x "$rouge" ] || { echo "skip - robust_fuzz_${kind}_$b: $rouge not built"; continue; }
+        opt=--$kind
+        render "$face" "$opt" "$f" -o "$tmp/o.png" >/dev/null 2>&1
+        rc=$?
+        if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_${kind}_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_${kind}_$b"; fi
+        rm -f "$tmp/o.png"
+    done
+done
+
+# ---- controls: the undamaged originals of the fixtures above are accepted ----
+if selected robust_controls_are_accepted && [ -x "$rouge" ]; then
+    if render "$face" --look "$bad/control_ok.look" --strokes "$bad/control_ok.strokes" -o "$tmp/ok.png" \
+        >/dev/null 2>"$tmp/err" && [ -s "$tmp/ok.png" ] && "$pack" --info "$tiny" >/dev/null 2>&1; then
+        echo "ok - robust_controls_are_accepted"
+    else
+        echo "FAIL - robust_controls_are_accepted: $(head -c 300 "$tmp/err")"
+    fi
+fi
+exit 0

@@ -1,0 +1,788 @@
+// rouge_bench.c — `make bench` (tools/bench.sh runs it): measures rouge on this machine and prints one
+// markdown table, the evidence the README quotes (docs/bench.md explains each row).
+//
+// Rows: machine and GL renderer; file bytes per splat (ours vs the float PLY's); conversion time of the
+// 600k scan and of the textured mesh (rouge-pack run as a child process); load time of the 600k face;
+// brush stamp cost for sizes 0.1/0.2/0.3; bare / reference / mobile frame times at 512x512 and 1280x720
+// and their ratios; mobile-vs-reference PSNR/SSIM/CIEDE2000 over 8 views x 2 lights in the diffuse and
+// full modes; peak CPU memory; GPU bytes per splat; the window's frame time while orbiting.
+// Every time is a median of repeated runs; frames are glFinish-timed wall times (on a real GPU that
+// is the GPU frame time; on llvmpipe the CPU's). Nothing here is asserted: timings are never tests.
+// A row whose input or program is missing says "n/a (why)" and the rest still runs.
+//
+//   build/rouge-bench --build build [--data ../shared/data] [--quick] [--face assets/face.rsf]
+#define _DEFAULT_SOURCE  // wait4 (per-child peak memory)
+
+#include "makeup.h"
+#include "render/render.h"
+#include "splat/splat.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/time.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+// ---- the table ----
+
+#define MAX_ROWS 64
+
+typedef struct row {
+    char what[96], value[192], notes[320];
+} row;
+
+typedef struct bench {
+    const char *build, *data, *face, *tmp;
+    bool quick;
+    int frames;                 // per frame-time configuration
+    row rows[MAX_ROWS];
+    int row_count;
+    rs_splat_cloud *cloud;
+} bench;
+
+static void add_row(bench *b, const char *what, const char *notes, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+static void add_row(bench *b, const char *what, const char *notes, const char *fmt, ...)
+{
+    if (b->row_count >= MAX_ROWS) return;
+    row *r = &b->rows[b->row_count++];
+    snprintf(r->what, sizeof r->what, "%s", what);
+    snprintf(r->notes, sizeof r->notes, "%s", notes ? notes : "");
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(r->value, sizeof r->value, fmt, ap);
+    va_end(ap);
+}
+
+static void progress(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+static void progress(const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    fputs("bench: ", stderr);
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+    va_end(ap);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+// Median (sorts in place); the mean of the two middle values for even n.
+static double median(double *v, int n)
+{
+    if (n <= 0) return NAN;
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static bool file_exists(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static long long file_size(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 ? (long long)st.st_size : -1;
+}
+
+// ---- child processes: wall time, peak memory, exit status ----
+
+typedef struct child_result {
+    bool ran;                   // started and exited on its own
+    int status;                 // exit code (or 128 + signal)
+    double wall_s;
+    long maxrss_kb;
+} child_result;
+
+// Runs argv with stdout to out_path (or /dev/null) and stderr to /dev/null, killing it after timeout_s.
+static child_result run_child(char *const argv[], const char *out_path, double timeout_s)
+{
+    child_result res = {0};
+    double t0 = rs_time_now();
+    pid_t pid = fork();
+    if (pid < 0) return res;
+    if (pid == 0) {
+        int out = open(out_path ? out_path : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC, 0644);
+        int null = open("/dev/null", O_WRONLY);
+        if (out >= 0) dup2(out, 1);
+        if (null >= 0) dup2(null, 2);
+        execv(argv[0], argv);
+        _exit(127);
+    }
+    int status = 0;
+    struct rusage ru;
+    memset(&ru, 0, sizeof ru);
+    for (;;) {
+        pid_t w = wait4(pid, &status, WNOHANG, &ru);
+        if (w == pid) break;
+        if (w < 0 && errno != EINTR) return res;
+        if (rs_time_now() - t0 > timeout_s) {
+            kill(pid, SIGKILL);
+            wait4(pid, &status, 0, &ru);
+            res.status = 124;
+            return res;
+        }
+        nanosleep(&(struct timespec){0, 5 * 1000 * 1000}, NULL);
+    }
+    res.wall_s = rs_time_now() - t0;
+    res.ran = true;
+    res.status = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+    res.maxrss_kb = ru.ru_maxrss;
+    return res;
+}
+
+// ---- machine ----
+
+static void machine_rows(bench *b)
+{
+    char model[160] = "unknown CPU";
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    if (f) {
+        char line[512];
+        while (fgets(line, sizeof line, f)) {
+            if (strncmp(line, "model name", 10) != 0) continue;
+            const char *c = strchr(line, ':');
+            if (!c) continue;
+            c++;
+            while (*c == ' ' || *c == '\t') c++;
+            snprintf(model, sizeof model, "%s", c);
+            model[strcspn(model, "\n")] = 0;
+            break;
+        }
+        fclose(f);
+    }
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    double load[1] = {0};
+    f = fopen("/proc/loadavg", "r");
+    if (f) {
+        if (fscanf(f, "%lf", &load[0]) != 1) load[0] = 0;
+        fclose(f);
+    }
+    char notes[128];
+    snprintf(notes, sizeof notes, "load average %.1f when the bench started (shared machines slow every row)",
+             load[0]);
+    add_row(b, "machine", notes, "%s, %ld cores", model, cores);
+}
+
+// ---- file size, conversion, load ----
+
+// Vertex count from a PLY header ("element vertex N"), 0 when not found.
+static unsigned long ply_vertex_count(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    char line[512];
+    unsigned long n = 0;
+    for (int i = 0; i < 200 && fgets(line, sizeof line, f); i++) {
+        if (sscanf(line, "element vertex %lu", &n) == 1) break;
+        if (!strncmp(line, "end_header", 10)) break;
+    }
+    fclose(f);
+    return n;
+}
+
+static void size_rows(bench *b, const char *ply)
+{
+    long long bytes = file_size(b->face);
+    uint32_t n = b->cloud->hdr.count;
+    double header = (double)bytes - 16.0 * n - 4.0;
+    char notes[320];
+    snprintf(notes, sizeof notes, "16 B records + %.0f B header/notes/CRC; goal <= 16 B (issue 3)", header);
+    add_row(b, "file bytes/splat: ours (.rsf)", notes, "%.2f B (%s: %lld B, %u splats)", (double)bytes / n,
+            b->face, bytes, n);
+    unsigned long pn = ply ? ply_vertex_count(ply) : 0;
+    if (!ply || pn == 0) {
+        add_row(b, "file bytes/splat: float PLY", NULL, "n/a (shared data absent)");
+        return;
+    }
+    long long pb = file_size(ply);
+    snprintf(notes, sizeof notes, "binary float xyz + normal + uchar rgb; ours is %.1fx smaller",
+             ((double)pb / pn) / ((double)bytes / n));
+    add_row(b, "file bytes/splat: float PLY", notes, "%.2f B (head_points_600k.ply: %lld B, %lu points)",
+            (double)pb / pn, pb, pn);
+}
+
+static void convert_row(bench *b, const char *what, char *const argv[], const char *out)
+{
+    char pack[512];
+    snprintf(pack, sizeof pack, "%s/rouge-pack", b->build);
+    if (!file_exists(pack)) {
+        add_row(b, what, NULL, "n/a (%s not built)", pack);
+        return;
+    }
+    int runs = b->quick ? 1 : 3;
+    double wall[8];
+    long rss = 0;
+    for (int i = 0; i < runs; i++) {
+        child_result c = run_child(argv, NULL, 300);
+        if (!c.ran || c.status != 0) {
+            add_row(b, what, NULL, "n/a (rouge-pack failed: exit %d)", c.status);
+            return;
+        }
+        wall[i] = c.wall_s;
+        rss = RS_MAX(rss, c.maxrss_kb);
+    }
+    rs_splat_cloud *c = NULL;
+    rs_error err = {0};
+    uint32_t count = 0;
+    if (rs_splat_load(out, &c, &err) == RS_OK) count = c->hdr.count;
+    rs_splat_destroy(c);
+    unlink(out);
+    char notes[320];
+    snprintf(notes, sizeof notes, "median of %d run%s, whole process (read PLY, normals/radii, LOD order, regions, "
+             "write); %u splats; peak RSS %.0f MiB", runs, runs > 1 ? "s" : "", count, rss / 1024.0);
+    double med = median(wall, runs);
+    add_row(b, what, notes, "%.2f s", med);
+}
+
+static void convert_rows(bench *b, const char *ply)
+{
+    char pack[512], out[512], mesh[512], tex[512], nmap[512];
+    snprintf(pack, sizeof pack, "%s/rouge-pack", b->build);
+    snprintf(out, sizeof out, "%s/convert.rsf", b->tmp);
+    if (!ply) {
+        add_row(b, "convert 600k point cloud", NULL, "n/a (shared data absent)");
+    } else {
+        progress("converting the 600k point cloud");
+        char *argv[] = {pack, (char *)ply, "-o", out, "-q", NULL};
+        convert_row(b, "convert 600k point cloud", argv, out);
+    }
+    snprintf(mesh, sizeof mesh, "%s/leeperrysmith/head_mesh.ply", b->data);
+    snprintf(tex, sizeof tex, "%s/leeperrysmith/color.png", b->data);
+    snprintf(nmap, sizeof nmap, "%s/leeperrysmith/normal.png", b->data);
+    if (!file_exists(mesh) || !file_exists(tex) || !file_exists(nmap)) {
+        add_row(b, "convert textured mesh, --points 600000", NULL, "n/a (shared data absent)");
+        return;
+    }
+    progress("converting the textured mesh at --points 600000");
+    char *argv[] = {pack, mesh, "--texture", tex, "--normal-map", nmap, "--points", "600000", "-o", out, "-q", NULL};
+    convert_row(b, "convert textured mesh, --points 600000", argv, out);
+}
+
+static void load_row(bench *b)
+{
+    int runs = b->quick ? 5 : 21;
+    double ms[32];
+    rs_error err = {0};
+    for (int i = 0; i < runs; i++) {
+        rs_splat_cloud *c = NULL;
+        double t0 = rs_time_now();
+        rs_result r = rs_splat_load(b->face, &c, &err);
+        ms[i] = (rs_time_now() - t0) * 1000.0;
+        rs_splat_destroy(c);
+        if (r) {
+            add_row(b, "load .rsf", NULL, "n/a (%s)", err.msg);
+            return;
+        }
+    }
+    char what[96], notes[160];
+    snprintf(what, sizeof what, "load %uk splats (.rsf)", (b->cloud->hdr.count + 500) / 1000);
+    snprintf(notes, sizeof notes, "rs_splat_load: read, CRC, validate, decode; median of %d (file in page cache)",
+             runs);
+    add_row(b, what, notes, "%.1f ms", median(ms, runs));
+}
+
+// ---- brush stamps ----
+
+// Splats a person would paint: a skin region of the face (not `other`) facing the camera.
+static uint32_t face_candidates(const rs_splat_cloud *c, uint32_t **out)
+{
+    uint32_t n = c->hdr.count, k = 0;
+    uint32_t *idx = rs_alloc_array(n, sizeof *idx);
+    if (!idx) return 0;
+    const float *fw = c->hdr.forward;
+    for (uint32_t i = 0; i < n; i++) {
+        uint8_t region = (uint8_t)(c->packed[i].w[1] >> 24);
+        const float *nm = c->normal[i];
+        if (region != RS_REGION_OTHER && nm[0] * fw[0] + nm[1] * fw[1] + nm[2] * fw[2] > 0.5f) idx[k++] = i;
+    }
+    if (k == 0) {  // a face without regions: anything facing forward
+        for (uint32_t i = 0; i < n; i++) {
+            const float *nm = c->normal[i];
+            if (nm[0] * fw[0] + nm[1] * fw[1] + nm[2] * fw[2] > 0.5f) idx[k++] = i;
+        }
+    }
+    *out = idx;
+    return k;
+}
+
+static void stamp_rows(bench *b)
+{
+    rs_error err = {0};
+    rs_makeup *mk = NULL;
+    uint32_t *cand = NULL;
+    uint32_t ncand = face_candidates(b->cloud, &cand);
+    const rs_cosmetic *blush = rs_cosmetic_find("blush");
+    if (ncand == 0 || !blush || rs_makeup_create(b->cloud, NULL, &mk, &err) != RS_OK) {
+        add_row(b, "stamp cost", NULL, "n/a (%s)", err.msg[0] ? err.msg : "no face splats / no blush preset");
+        free(cand);
+        return;
+    }
+    enum { STROKE = 16, MAX_STAMPS = 512 };
+    int stamps = b->quick ? 128 : MAX_STAMPS;
+    static double us[MAX_STAMPS], touched[MAX_STAMPS];
+    const float sizes[3] = {0.1f, 0.2f, 0.3f};
+    uint64_t seed = 0x9E3779B97F4A7C15u;
+    for (int s = 0; s < 3; s++) {
+        rs_makeup_range dirty;
+        rs_makeup_reset(mk, &dirty);
+        rs_makeup_stamp_desc d = {.opacity = 0.5f, .pressure = 1.0f, .cosmetic = blush,
+                                  .radius = rs_makeup_brush_radius(&b->cloud->hdr, sizes[s])};
+        memcpy(d.view_dir, b->cloud->hdr.forward, sizeof d.view_dir);
+        rs_result r = RS_OK;
+        for (int i = 0; i < stamps && !r; i++) {
+            if (i % STROKE == 0) rs_makeup_begin_stroke(mk);
+            seed = seed * 6364136223846793005u + 1442695040888963407u;
+            uint32_t at = cand[(uint32_t)(seed >> 33) % ncand];
+            memcpy(d.pos, b->cloud->pos[at], sizeof d.pos);
+            rs_makeup_stamp_info info;
+            double t0 = rs_time_now();
+            r = rs_makeup_stamp(mk, &d, &info, &err);
+            us[i] = (rs_time_now() - t0) * 1e6;
+            touched[i] = info.touched;
+            if (i % STROKE == STROKE - 1 || i == stamps - 1) {
+                if (!r) r = rs_makeup_end_stroke(mk, &err);
+                rs_makeup_forget_history(mk);  // keep the undo history from growing over the run
+            }
+        }
+        char what[64], notes[200];
+        snprintf(what, sizeof what, "stamp cost, brush size %.1f", sizes[s]);
+        if (r) {
+            add_row(b, what, NULL, "n/a (%s)", err.msg);
+            continue;
+        }
+        double med = median(us, stamps), p90 = us[(stamps * 9) / 10];
+        snprintf(notes, sizeof notes, "rs_makeup_stamp on %u splats, median of %d at face positions (p90 %.0f µs); "
+                 "median %.0f splats touched; goal well under 1 ms", b->cloud->hdr.count, stamps, p90,
+                 median(touched, stamps));
+        add_row(b, what, notes, "%.0f µs", med);
+    }
+    rs_makeup_destroy(mk);
+    free(cand);
+}
+
+// ---- peak memory (a child process, forked before this process creates any GL context) ----
+
+static void memory_row(bench *b)
+{
+    fflush(NULL);
+    pid_t pid = fork();
+    if (pid < 0) {
+        add_row(b, "peak memory (CPU)", NULL, "n/a (fork failed)");
+        return;
+    }
+    if (pid == 0) {
+        rs_error err = {0};
+        rs_splat_cloud *c = NULL;
+        rs_gl_context *gl = NULL;
+        rs_renderer *r = NULL;
+        rs_image img = {0};
+        rs_view v = rs_view_defaults();
+        v.width = 1280, v.height = 720;
+        rs_result res = rs_splat_load(b->face, &c, &err);
+        if (!res) res = rs_gl_create(&(rs_gl_desc){.kind = RS_GL_HEADLESS}, &gl, &err);
+        if (!res) res = rs_render_create(&(rs_render_desc){.cloud = c, .caps = rs_gl_get_caps(gl)}, &r, &err);
+        if (!res) res = rs_render_image(r, &v, &img, &err);
+        _exit(res ? 1 : 0);  // no cleanup: the peak is what we measure
+    }
+    int status = 0;
+    struct rusage ru;
+    memset(&ru, 0, sizeof ru);
+    while (wait4(pid, &status, 0, &ru) < 0 && errno == EINTR) {}
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+        add_row(b, "peak memory (CPU)", NULL, "n/a (headless render failed)");
+        return;
+    }
+    char notes[200];
+    snprintf(notes, sizeof notes, "ru_maxrss of a process that loads the face and renders one 1280x720 reference "
+             "frame (includes the GL driver: llvmpipe keeps its targets in CPU memory)");
+    add_row(b, "peak memory (CPU)", notes, "%.0f MiB (%.0f B/splat)", ru.ru_maxrss / 1024.0,
+            ru.ru_maxrss * 1024.0 / b->cloud->hdr.count);
+}
+
+// ---- frame times ----
+
+// The bare floors: visibility + attribute + normalise only. Albedo mode has no lighting, so the renderer
+// skips the shadow map and the diffusion stage (rs_render_frame_setup: lit/diffuse false). The mobile
+// pipeline's floor is its own passes (its targets, its LOD) at the mobile frame's splat count; the
+// reference's is every splat through the reference passes. Mobile runs first: its floor takes the
+// splat count from its frame.
+typedef enum { CFG_MOBILE, CFG_BARE_MOBILE, CFG_REFERENCE, CFG_BARE_REFERENCE, CFG_COUNT } frame_cfg;
+static const char *const cfg_names[CFG_COUNT] = {"mobile", "bare, mobile pipeline", "reference",
+                                                 "bare, reference pipeline"};
+
+// max_splats: the mobile frame's splat count, for CFG_BARE_MOBILE.
+static rs_view cfg_view(frame_cfg cfg, int w, int h, uint32_t max_splats)
+{
+    rs_view v = rs_view_defaults();
+    v.width = w, v.height = h;
+    v.pipeline = cfg == CFG_MOBILE || cfg == CFG_BARE_MOBILE ? RS_PIPELINE_MOBILE : RS_PIPELINE_REFERENCE;
+    if (cfg == CFG_BARE_MOBILE || cfg == CFG_BARE_REFERENCE) {
+        v.mode = RS_MODE_ALBEDO;
+        v.no_shadows = true;
+        if (cfg == CFG_BARE_MOBILE) v.max_splats = max_splats;
+    }
+    return v;
+}
+
+typedef struct frame_result {
+    bool ok;
+    double ms;                  // median
+    rs_render_stats stats;      // of the last frame
+    char err[160];
+} frame_result;
+
+// Times the configurations at one size, interleaved frame by frame so that load from other
+// processes (a shared machine) slows them alike instead of whichever ran at the time. Each has its
+// own renderer: the shadow map is cached per renderer while the light stays put (as when orbiting), and
+// one renderer alternating pipelines (different LOD prefixes) would redraw it every frame.
+static void time_frames(rs_renderer *r[CFG_COUNT], int w, int h, int frames, frame_result out[CFG_COUNT])
+{
+    static double ms[CFG_COUNT][64];
+    rs_error err = {0};
+    frames = RS_MIN(frames, 64);
+    memset(out, 0, CFG_COUNT * sizeof *out);
+    bool failed[CFG_COUNT] = {false};
+    for (int i = -1; i < frames; i++) {  // a warm-up frame: targets, shader variants, the mobile fit
+        for (int c = 0; c < CFG_COUNT; c++) {
+            if (failed[c]) continue;
+            rs_view v = cfg_view((frame_cfg)c, w, h, out[CFG_MOBILE].stats.splats_drawn);
+            double t0 = rs_time_now();
+            if (rs_render_frame(r[c], &v, &err) != RS_OK) {
+                snprintf(out[c].err, sizeof out[c].err, "%s", err.msg);
+                failed[c] = true;
+                continue;
+            }
+            glFinish();
+            if (i >= 0) ms[c][i] = (rs_time_now() - t0) * 1000.0;
+            out[c].stats = rs_render_get_stats(r[c]);
+        }
+    }
+    for (int c = 0; c < CFG_COUNT; c++) {
+        out[c].ok = !failed[c];
+        out[c].ms = failed[c] ? NAN : median(ms[c], frames);
+    }
+}
+
+static void frame_rows(bench *b, rs_gl_context *gl)
+{
+    const int sizes[2][2] = {{512, 512}, {1280, 720}};
+    rs_renderer *r[CFG_COUNT] = {NULL};
+    rs_error err = {0};
+    for (int c = 0; c < CFG_COUNT; c++) {
+        if (rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r[c], &err) == RS_OK)
+            continue;
+        add_row(b, "frame times", NULL, "n/a (%s)", err.msg);
+        for (int k = 0; k < c; k++) rs_render_destroy(r[k]);
+        return;
+    }
+    for (int s = 0; s < 2; s++) {
+        progress("mobile / reference / bare frames at %dx%d", sizes[s][0], sizes[s][1]);
+        frame_result fr[CFG_COUNT];
+        time_frames(r, sizes[s][0], sizes[s][1], b->frames, fr);
+        for (int c = 0; c < CFG_COUNT; c++) {
+            char what[96], notes[320];
+            snprintf(what, sizeof what, "frame %s, %dx%d", cfg_names[c], sizes[s][0], sizes[s][1]);
+            if (!fr[c].ok) {
+                add_row(b, what, NULL, "n/a (%s)", fr[c].err);
+                continue;
+            }
+            const char *what_runs = c == CFG_BARE_MOBILE || c == CFG_BARE_REFERENCE
+                                        ? "albedo mode, no shadows: visibility + attribute + normalise"
+                                    : c == CFG_REFERENCE ? "full mode, reference pipeline (6 Gaussians)"
+                                                         : "full mode, mobile pipeline";
+            const rs_render_stats *st = &fr[c].stats;
+            snprintf(notes, sizeof notes, "%s; %u splats drawn, %d diffusion levels (%u diffusion splats), %s; "
+                     "median of %d", what_runs, st->splats_drawn, st->kernel_count, st->diffusion_splats,
+                     st->used_points ? "point sprites" : "quads", b->frames);
+            add_row(b, what, notes, "%.1f ms", fr[c].ms);
+        }
+        char what[96];
+        double ref = fr[CFG_REFERENCE].ms, mob = fr[CFG_MOBILE].ms;
+        snprintf(what, sizeof what, "ratios at %dx%d", sizes[s][0], sizes[s][1]);
+        add_row(b, what, "goals (issue 5): reference/mobile >= 5x, mobile/bare <= 2.5x (each over its own floor)",
+                "reference/mobile %.2fx, mobile/bare %.2fx, reference/bare %.2fx", ref / mob,
+                mob / fr[CFG_BARE_MOBILE].ms, ref / fr[CFG_BARE_REFERENCE].ms);
+    }
+    for (int c = 0; c < CFG_COUNT; c++) rs_render_destroy(r[c]);
+}
+
+// Where a frame's time goes, per stage (glFinish after each stage: slower overall, so separate rows).
+static void stage_rows(bench *b, rs_gl_context *gl)
+{
+    rs_renderer *r = NULL;
+    rs_error err = {0};
+    if (rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl), .time_stages = true}, &r,
+                         &err) != RS_OK) {
+        add_row(b, "stages", NULL, "n/a (%s)", err.msg);
+        return;
+    }
+    const frame_cfg cfgs[2] = {CFG_REFERENCE, CFG_MOBILE};
+    for (int j = 0; j < 2; j++) {
+        frame_cfg c = cfgs[j];
+        rs_view v = cfg_view(c, 512, 512, 0);
+        int n = b->quick ? 3 : 5;
+        double st[RS_STAGE_COUNT][16];
+        bool ok = true;
+        for (int i = -1; i < n && ok; i++) {
+            // The shadow map is cached while the light stays put; nudging the light redraws it, so the
+            // shadow column shows what a light move costs.
+            v.key.yaw_deg += 0.5f;
+            ok = rs_render_frame(r, &v, &err) == RS_OK;
+            rs_render_stats s = rs_render_get_stats(r);
+            for (int k = 0; ok && i >= 0 && k < RS_STAGE_COUNT; k++) st[k][i] = s.stage_ms[k];
+        }
+        char what[96];
+        snprintf(what, sizeof what, "stages %s, 512x512", cfg_names[c]);
+        if (!ok) {
+            add_row(b, what, NULL, "n/a (%s)", err.msg);
+            continue;
+        }
+        double m[RS_STAGE_COUNT];
+        for (int k = 0; k < RS_STAGE_COUNT; k++) m[k] = median(st[k], n);
+        add_row(b, what, "median ms per stage (paper Fig. 2), glFinish after each; the light moves every frame "
+                "(in the frame rows it stays put and the shadow map is cached)",
+                "shadow %.1f, visibility %.1f, attribute %.1f, diffusion %.1f, composite %.1f ms", m[0], m[1], m[2],
+                m[3], m[4]);
+    }
+    rs_render_destroy(r);
+}
+
+// ---- mobile vs reference quality ----
+
+static void quality_rows(bench *b, rs_renderer *r)
+{
+    // 8 views around the front of the face x 2 key-light directions (issue 5's fixed set).
+    static const float views[8][2] = {{0, 0},   {-30, 0}, {30, 0},   {-60, 5},
+                                      {60, 5},  {0, 25},  {-20, -15}, {25, -10}};
+    static const float lights[2][2] = {{-35, 30}, {50, 10}};
+    int nviews = b->quick ? 2 : 8, size = 512;
+    const rs_render_mode modes[2] = {RS_MODE_DIFFUSE, RS_MODE_FULL};
+    const char *mode_names[2] = {"diffuse", "full"};
+    for (int m = 0; m < 2; m++) {
+        double psnr_sum = 0, ssim_sum = 0, de_sum = 0, psnr_min = INFINITY, ssim_min = INFINITY, de_max = 0;
+        int n = 0, identical = 0;
+        char worst[64] = "";
+        rs_error err = {0};
+        bool ok = true;
+        progress("quality, %s mode: %d views x 2 lights", mode_names[m], nviews);
+        for (int l = 0; l < 2 && ok; l++) {
+            for (int i = 0; i < nviews && ok; i++) {
+                rs_view v = rs_view_defaults();
+                v.width = v.height = size;
+                v.mode = modes[m];
+                v.yaw_deg = views[i][0], v.pitch_deg = views[i][1];
+                v.key.yaw_deg = lights[l][0], v.key.pitch_deg = lights[l][1];
+                rs_image ref = {0}, mob = {0};
+                rs_image_metrics q;
+                v.pipeline = RS_PIPELINE_REFERENCE;
+                ok = rs_render_image(r, &v, &ref, &err) == RS_OK;
+                v.pipeline = RS_PIPELINE_MOBILE;
+                if (ok) ok = rs_render_image(r, &v, &mob, &err) == RS_OK;
+                if (ok) ok = rs_image_compare(&ref, &mob, 8, &q, &err) == RS_OK;
+                rs_image_free(&ref);
+                rs_image_free(&mob);
+                if (!ok) break;
+                n++;
+                if (isinf(q.psnr)) identical++;
+                double p = isinf(q.psnr) ? 99.0 : q.psnr;  // identical images count as 99 dB in the mean
+                psnr_sum += p, ssim_sum += q.ssim, de_sum += q.delta_e;
+                if (p < psnr_min) {
+                    psnr_min = p;
+                    snprintf(worst, sizeof worst, "yaw %g pitch %g, light %d", views[i][0], views[i][1], l + 1);
+                }
+                ssim_min = fmin(ssim_min, q.ssim);
+                de_max = fmax(de_max, q.delta_e);
+            }
+        }
+        char what[96], notes[320];
+        snprintf(what, sizeof what, "mobile vs reference, %s, %dx%d", mode_names[m], size, size);
+        if (!ok) {
+            add_row(b, what, NULL, "n/a (%s)", err.msg);
+            continue;
+        }
+        snprintf(notes, sizeof notes, "%d views x 2 lights; worst view: %s; goals: mean PSNR >= 38 dB, every view "
+                 ">= 34, SSIM >= 0.97, mean ΔE <= 1.5%s", nviews, worst,
+                 identical == n ? "; IDENTICAL images: the mobile pipeline draws what the reference does" : "");
+        add_row(b, what, notes, "PSNR mean %.1f / worst %.1f dB, SSIM mean %.4f / worst %.4f, ΔE00 mean %.2f / "
+                "worst %.2f", psnr_sum / n, psnr_min, ssim_sum / n, ssim_min, de_sum / n, de_max);
+    }
+}
+
+static void gpu_row(bench *b, rs_renderer *r)
+{
+    rs_view v = cfg_view(CFG_REFERENCE, 1280, 720, 0);
+    rs_error err = {0};
+    if (rs_render_frame(r, &v, &err) != RS_OK) {
+        add_row(b, "GPU bytes/splat", NULL, "n/a (%s)", err.msg);
+        return;
+    }
+    rs_render_stats s = rs_render_get_stats(r);
+    uint32_t n = b->cloud->hdr.count;
+    size_t records = (size_t)n * (sizeof(rs_splat_packed) + sizeof(rs_makeup_gpu));
+    char notes[256];
+    snprintf(notes, sizeof notes, "buffers: %zu B splat record + %zu B makeup record per splat; with every render "
+             "target at 1280x720 (rs_render_stats.gpu_bytes = %.1f MiB)", sizeof(rs_splat_packed),
+             sizeof(rs_makeup_gpu), s.gpu_bytes / 1048576.0);
+    add_row(b, "GPU bytes/splat", notes, "%.0f B in buffers, %.1f B with targets", (double)records / n,
+            (double)s.gpu_bytes / n);
+}
+
+// ---- the window (rouge view --bench-orbit) ----
+
+static void window_row(bench *b)
+{
+    const char *what = "window frame, 800x600, orbiting";
+    char rouge[512], out[512], help[512];
+    snprintf(rouge, sizeof rouge, "%s/rouge", b->build);
+    snprintf(out, sizeof out, "%s/orbit.txt", b->tmp);
+    snprintf(help, sizeof help, "%s/help.txt", b->tmp);
+    if (!file_exists(rouge)) {
+        add_row(b, what, NULL, "n/a (%s not built)", rouge);
+        return;
+    }
+    if (!getenv("DISPLAY") && !getenv("WAYLAND_DISPLAY")) {
+        add_row(b, what, NULL, "n/a (no display: tools/bench.sh starts Xvfb when it is installed)");
+        return;
+    }
+    // Only a viewer that has the option: older builds would open a window and wait for a person.
+    char *hargv[] = {rouge, "--help", NULL};
+    run_child(hargv, help, 10);
+    FILE *f = fopen(help, "r");
+    bool has = false;
+    char line[512];
+    while (f && fgets(line, sizeof line, f)) has = has || strstr(line, "--bench-orbit");
+    if (f) fclose(f);
+    if (!has) {
+        add_row(b, what, NULL, "n/a (this rouge has no --bench-orbit)");
+        return;
+    }
+    progress("viewer orbit at 800x600");
+    char frames[16];
+    snprintf(frames, sizeof frames, "%d", b->quick ? 10 : 30);
+    char *argv[] = {rouge, "view", (char *)b->face, "--size", "800x600", "--bench-orbit", frames, NULL};
+    child_result c = run_child(argv, out, 300);
+    f = fopen(out, "r");
+    char result[512] = "";
+    while (f && fgets(line, sizeof line, f))
+        if (strstr(line, "bench-orbit:")) snprintf(result, sizeof result, "%s", line);
+    if (f) fclose(f);
+    double med = 0;
+    const char *m = strstr(result, "median ");
+    if (!c.ran || c.status != 0 || !m || sscanf(m, "median %lf", &med) != 1) {
+        add_row(b, what, NULL, "n/a (rouge view --bench-orbit failed: exit %d)", c.status);
+        return;
+    }
+    result[strcspn(result, "\n")] = 0;
+    const char *detail = strchr(result, ':');
+    add_row(b, what, detail ? detail + 2 : result, "%.1f ms", med);
+}
+
+// ---- main ----
+
+static void print_table(const bench *b, FILE *f)
+{
+    fprintf(f, "| measure | value | notes |\n|---|---|---|\n");
+    for (int i = 0; i < b->row_count; i++)
+        fprintf(f, "| %s | %s | %s |\n", b->rows[i].what, b->rows[i].value, b->rows[i].notes);
+}
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: rouge-bench --build DIR [--data DIR] [--face FILE.rsf] [--tmp DIR] [--quick] "
+                    "[--out FILE.md]\n");
+    return 2;
+}
+
+int main(int argc, char **argv)
+{
+    bench *b = calloc(1, sizeof *b);
+    if (!b) return 1;
+    const char *out_md = NULL;
+    b->build = "build";
+    b->face = "assets/face.rsf";
+    b->data = getenv("RS_SHARED_DATA") && *getenv("RS_SHARED_DATA") ? getenv("RS_SHARED_DATA") : "../shared/data";
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--quick")) b->quick = true;
+        else if (!v) return usage();
+        else if (!strcmp(a, "--build")) b->build = v, i++;
+        else if (!strcmp(a, "--data")) b->data = v, i++;
+        else if (!strcmp(a, "--face")) b->face = v, i++;
+        else if (!strcmp(a, "--tmp")) b->tmp = v, i++;
+        else if (!strcmp(a, "--out")) out_md = v, i++;
+        else return usage();
+    }
+    char tmp[512];
+    if (!b->tmp) {
+        snprintf(tmp, sizeof tmp, "%s/bench", b->build);
+        b->tmp = tmp;
+    }
+    mkdir(b->tmp, 0755);
+    b->frames = b->quick ? 5 : 20;  // issue 5: >= 20 frames
+
+    rs_error err = {0};
+    if (rs_splat_load(b->face, &b->cloud, &err) != RS_OK) {
+        fprintf(stderr, "rouge-bench: %s\n", err.msg);
+        return 1;
+    }
+    char ply_path[512];
+    snprintf(ply_path, sizeof ply_path, "%s/leeperrysmith/head_points_600k.ply", b->data);
+    const char *ply = file_exists(ply_path) ? ply_path : NULL;
+
+    machine_rows(b);
+    int gl_row = b->row_count;
+    add_row(b, "GL renderer", NULL, "n/a");  // filled in once the context exists
+    size_rows(b, ply);
+    convert_rows(b, ply);
+    load_row(b);
+    progress("brush stamps");
+    stamp_rows(b);
+    progress("peak memory");
+    memory_row(b);  // before this process has a GL context (fork)
+
+    rs_gl_context *gl = NULL;
+    rs_renderer *r = NULL;
+    if (rs_gl_create(&(rs_gl_desc){.kind = RS_GL_HEADLESS}, &gl, &err) != RS_OK ||
+        rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r, &err) != RS_OK) {
+        snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "n/a (%s)", err.msg);
+        add_row(b, "frame times, quality, GPU bytes", NULL, "n/a (no GLES 3 context)");
+    } else {
+        const rs_gl_caps *caps = rs_gl_get_caps(gl);
+        snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "%s", caps->renderer);
+        snprintf(b->rows[gl_row].notes, sizeof b->rows[gl_row].notes, "%s, %s; float targets %s",
+                 caps->platform, caps->version, caps->float_rt ? "yes" : "no");
+        frame_rows(b, gl);
+        progress("per-stage timings");
+        stage_rows(b, gl);
+        quality_rows(b, r);
+        gpu_row(b, r);
+    }
+    rs_render_destroy(r);
+    rs_gl_destroy(gl);
+    window_row(b);
+
+    print_table(b, stdout);
+    if (out_md) {
+        FILE *f = fopen(out_md, "w");
+        if (f) print_table(b, f), fclose(f);
+    }
+    rs_splat_destroy(b->cloud);
+    free(b);
+    return 0;
+}
