@@ -39,6 +39,7 @@ uniform vec3 u_fill_dir;
 uniform vec3 u_fill_color;
 uniform vec3 u_ambient;
 uniform float u_min_weight;     // accumulated weights below this are unreliable (RGBA8 fallback): a hole
+uniform int u_lean;             // 1: two attribute targets, RT1 = (normal.xy, m, rho_s) w (no RT2)
 
 out vec4 o_color;
 
@@ -57,6 +58,14 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
     t0 = t1 = t2 = vec4(0.0);
     p = D = vec3(0.0);
     ivec2 hi = ivec2(u_viewport) - 1;
+    // Quick reject (most background pixels): with 3 of the 4 edge neighbours uncovered, at most 5 of 8
+    // can be covered.
+    int open = 0;
+    for (int i = 0; i < 4; i++) {
+        ivec2 q = clamp(px + ivec2(i == 0 ? -1 : i == 1 ? 1 : 0, i == 2 ? -1 : i == 3 ? 1 : 0), ivec2(0), hi);
+        if (texelFetch(u_attr0, q, 0).a <= u_min_weight) open++;
+    }
+    if (open >= 3) return false;
     int k = 0;
     for (int i = 0; i < 9; i++) {
         if (i == 4) continue;
@@ -91,10 +100,21 @@ void main()
     }
     float inv = 1.0 / t0.a;
     vec3 A = t0.rgb * inv;
-    vec3 N = normalize(t1.xyz * inv * 2.0 - 1.0);
-    float m = t1.a * inv;
-    float rho_s = t2.r * inv * u_rho_s_scale;
-    vec3 debug = t2.gba * inv;
+    vec3 N, debug = vec3(0.0);
+    float m, rho_s;
+    if (u_lean == 1) {
+        // The visible side faces the camera: z >= 0 (silhouette splats tilted a little away excepted).
+        vec2 nxy = t1.xy * inv;
+        N = vec3(nxy, sqrt(max(1.0 - dot(nxy, nxy), 0.0)));
+        N = normalize(N);
+        m = t1.z * inv;
+        rho_s = t1.w * inv * u_rho_s_scale;
+    } else {
+        N = normalize(t1.xyz * inv * 2.0 - 1.0);
+        m = t1.a * inv;
+        rho_s = t2.r * inv * u_rho_s_scale;
+        debug = t2.gba * inv;
+    }
     vec3 V = normalize(-p);
 
     if (u_mode == MODE_NORMALS) { o_color = vec4(N * 0.5 + 0.5, 1.0); return; }

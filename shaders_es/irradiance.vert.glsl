@@ -20,6 +20,7 @@ uniform vec3 u_fill_color;      // zero when the fill light is off
 uniform vec3 u_ambient;
 uniform highp sampler2D u_depth;  // visibility depth
 uniform float u_eps;
+uniform float u_reach;          // the widest kernel's reach (3 sigma), view units
 
 out vec4 v_irradiance;          // (E, distance behind the visible surface; -1: faces the eye or in view)
 
@@ -37,15 +38,32 @@ float behind_visible(vec3 c)
     return length(c) - (length(h.xyz / h.w) - u_eps);
 }
 
+// How far view-space point c lies outside the view frustum's side planes (0 inside), view units.
+float outside_view(vec3 c)
+{
+    vec4 h = vec4(c, 1.0);
+    vec4 rx = vec4(u_proj[0][0], u_proj[1][0], u_proj[2][0], u_proj[3][0]);
+    vec4 ry = vec4(u_proj[0][1], u_proj[1][1], u_proj[2][1], u_proj[3][1]);
+    vec4 rw = vec4(u_proj[0][3], u_proj[1][3], u_proj[2][3], u_proj[3][3]);
+    float d = 0.0;
+    vec4 planes[4] = vec4[4](rw - rx, rw + rx, rw - ry, rw + ry);
+    for (int i = 0; i < 4; i++) d = max(d, -dot(planes[i], h) / length(planes[i].xyz));
+    return d;
+}
+
 void main()
 {
     rs_splat s = rs_decode_splat(a_splat);
     vec3 c = (u_view * vec4(s.pos, 1.0)).xyz;
     vec3 n = mat3(u_view) * s.normal;
+    float behind = dot(n, -c) < 0.0 ? behind_visible(c) : -1.0;
     vec3 e = u_key_color * max(dot(n, u_key_dir), 0.0);
-    if (dot(e, e) > 0.0) e *= rs_shadow(c, n);
+    // Splats no kernel carries to a visible pixel (the back of the head, the shoulders below the view)
+    // skip the shadow-map lookup: their E is never read.
+    bool unseen = behind > u_reach || outside_view(c) > u_reach;
+    if (dot(e, e) > 0.0 && !unseen) e *= rs_shadow(c, n);
     e += u_fill_color * max(dot(n, u_fill_dir), 0.0) + u_ambient;
-    v_irradiance = vec4(e, dot(n, -c) < 0.0 ? behind_visible(c) : -1.0);
+    v_irradiance = vec4(e, behind);
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
     gl_PointSize = 1.0;
 }

@@ -44,21 +44,30 @@ float rs_depth_of(vec3 q)
 uniform highp sampler2D u_depth;  // visibility pass depth, pushed back by u_eps along the view ray
 uniform float u_eps;              // that push, view units
 
-// The front surface point under pixel px (view space), undoing the visibility pass's push; false on
-// background. The camera is perspective: the ray runs from the eye at the origin through the point.
+// The front surface point under pixel px of the depth texture (view space), undoing the visibility
+// pass's push; false on background. The camera is perspective: the ray runs from the eye at the origin
+// through the point. Works from targets of another size too (reduced-resolution diffusion levels):
+// px is always a pixel of the depth texture.
 bool rs_visible_point_at(ivec2 px, out vec3 p)
 {
     float z = texelFetch(u_depth, px, 0).r;
     p = vec3(0.0);
     if (z >= 1.0) return false;
-    vec4 h = u_inv_proj * vec4(rs_pixel_ndc(vec2(px) + 0.5), z * 2.0 - 1.0, 1.0);
+    vec2 ndc = (vec2(px) + 0.5) / vec2(textureSize(u_depth, 0)) * 2.0 - 1.0;
+    vec4 h = u_inv_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
     p = h.xyz / h.w;
     p -= normalize(p) * u_eps;
     return true;
 }
 
+// The depth texture's pixel holding the centre of this target's pixel (the same pixel at full size).
+ivec2 rs_depth_pixel(vec2 frag)
+{
+    return ivec2(frag / u_viewport * vec2(textureSize(u_depth, 0)));
+}
+
 bool rs_visible_point(out vec3 p)
 {
-    return rs_visible_point_at(ivec2(gl_FragCoord.xy), p);
+    return rs_visible_point_at(rs_depth_pixel(gl_FragCoord.xy), p);
 }
 #endif

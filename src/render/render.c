@@ -92,6 +92,7 @@ static rs_view view_resolved(const rs_view *in)
     if (v.fov_deg <= 0) v.fov_deg = 30.0f;
     if (v.exposure <= 0) v.exposure = 1.0f;
     if (v.rho_s_scale <= 0) v.rho_s_scale = 1.0f;
+    if (!(v.lod_density > 0)) v.lod_density = RS_LOD_DENSITY_DEFAULT;
     if (v.key.intensity <= 0) v.key.intensity = 1.0f;
     rs_light *lights[2] = {&v.key, &v.fill};
     for (int i = 0; i < 2; i++)
@@ -100,11 +101,78 @@ static rs_view view_resolved(const rs_view *in)
     return v;
 }
 
-static uint32_t main_count(const rs_renderer *r, const rs_view *v)
+// The face's screen area in pixels (*face_px) and the number of splats of the whole cloud per visible
+// splat (the returned ratio A_total / A_visible), from an even subsample (the coarsest LOD prefix): each
+// sample stands for area_total / n of the surface, and counts when it faces the camera and projects into
+// the view, with its foreshortening (n.v) over its squared distance. Overlapping layers (an ear in front
+// of the cheek) count twice: a few percent on a face (measured within 2% of the covered pixels).
+static float face_pixels(const rs_renderer *r, const rs_camera *cam, float *face_px)
 {
-    uint32_t n = r->cloud->hdr.count;
+    const rs_splat_cloud *c = r->cloud;
+    const rs_splat_header *h = &c->hdr;
+    uint32_t n = h->lod_count > 0 ? h->lods[h->lod_count - 1] : h->count;
+    // Without a coarse LOD level, every k-th record.
+    uint32_t step = 1;
+    if (h->lod_count <= 1 || n > 40000) {
+        step = RS_MAX(h->count / 20000u, 1u);
+        n = h->count;
+    }
+    mat4 vp;
+    glm_mat4_mul((vec4 *)cam->proj, (vec4 *)cam->view, vp);
+    double solid = 0;
+    uint32_t visible = 0, samples = 0;
+    for (uint32_t i = 0; i < n; i += step) {
+        samples++;
+        vec3 d = {cam->eye[0] - c->pos[i][0], cam->eye[1] - c->pos[i][1], cam->eye[2] - c->pos[i][2]};
+        float facing = glm_vec3_dot(d, c->normal[i]);
+        if (facing <= 0) continue;
+        vec4 p = {c->pos[i][0], c->pos[i][1], c->pos[i][2], 1.0f}, q;
+        glm_mat4_mulv(vp, p, q);
+        if (!(q[3] > 0 && fabsf(q[0]) <= q[3] && fabsf(q[1]) <= q[3])) continue;
+        float dist2 = glm_vec3_dot(d, d);
+        solid += facing / (dist2 * sqrtf(dist2));
+        visible++;
+    }
+    float per_sample = r->area_total / (float)samples;
+    *face_px = (float)(solid * per_sample) / (cam->px_size * cam->px_size);
+    return visible ? (float)samples / (float)visible : 0.0f;
+}
+
+// Splats in the main passes: the max_splats cap; the mobile pipeline also the LOD prefix nearest (in log)
+// to lod_density visible splats per pixel of the face's screen area (the prefix is spread evenly over
+// the whole surface, so it holds `ratio` times the visible ones). The LOD table steps by ~2x: the density
+// drawn is within ~0.7x..1.4x of the asked one. Zooming in raises it, up to the whole cloud; small views
+// stop at RS_MOBILE_MAX_LOD_STEPS below the cap.
+static uint32_t main_count(const rs_renderer *r, const rs_view *v, const rs_camera *cam, float *face_px)
+{
+    const rs_splat_header *h = &r->cloud->hdr;
+    uint32_t n = h->count;
     if (v->max_splats > 0 && v->max_splats < n) n = rs_splat_lod_count(r->cloud, v->max_splats);
-    return n;
+    *face_px = 0;
+    if (v->pipeline != RS_PIPELINE_MOBILE) return n;
+    float density = v->lod_density > 0 ? v->lod_density : RS_LOD_DENSITY_DEFAULT;
+    float ratio = face_pixels(r, cam, face_px);
+    double want = fmax((double)density * *face_px * ratio, 1.0);
+    uint32_t best = n, steps = 0;
+    double best_err = INFINITY;
+    for (uint32_t k = 0; k < h->lod_count; k++) {
+        uint32_t m = h->lods[k];
+        if (m > n) continue;
+        if (m < n && ++steps > RS_MOBILE_MAX_LOD_STEPS) break;
+        double e = fabs(log((double)m / want));
+        if (e < best_err) best_err = e, best = m;
+    }
+    return best;
+}
+
+uint32_t rs_render_auto_splats(const rs_renderer *r, const rs_view *view)
+{
+    rs_view v = view_resolved(view);
+    if (v.width <= 0 || v.height <= 0) return 0;
+    rs_camera cam;
+    rs_render_camera(r, &v, &cam);
+    float face_px;
+    return main_count(r, &v, &cam, &face_px);
 }
 
 bool rs_render_needs_quads(const rs_renderer *r, const rs_frame *f, float radius)
@@ -119,8 +187,16 @@ void rs_render_frame_setup(const rs_renderer *r, const rs_view *view, rs_frame *
     f->view = view_resolved(view);
     const rs_view *v = &f->view;
     rs_render_camera(r, v, &f->cam);
-    f->count = main_count(r, v);
+    f->mobile = v->pipeline == RS_PIPELINE_MOBILE;
+    f->shadow_slot = f->mobile ? 1 : 0;
+    f->count = main_count(r, v, &f->cam, &f->face_px);
     f->radius_scale = rs_splat_lod_radius_scale(r->cloud, f->count);
+    if (f->mobile) {
+        // Even prefixes close the surface with smaller radii than sqrt(N / n) x the full cloud's
+        // (RS_MOBILE_COVER), never below the full cloud's own: the reconstruction filter, and with it
+        // the silhouette, stays as close as the sampling allows to the reference's of all splats.
+        f->radius_scale = fmaxf(1.0f, RS_MOBILE_COVER * f->radius_scale);
+    }
     float rmax = r->cloud->hdr.radius_max * f->radius_scale * RS_COVERAGE;
     f->quads = v->prim == RS_PRIM_QUADS || (v->prim == RS_PRIM_AUTO && rs_render_needs_quads(r, f, rmax));
     // Half a typical splat radius: overlapping splats of one surface blend, a surface behind (the far
@@ -131,6 +207,7 @@ void rs_render_frame_setup(const rs_renderer *r, const rs_view *view, rs_frame *
     f->lit = m == RS_MODE_FULL || m == RS_MODE_DIFFUSE || m == RS_MODE_SPECULAR || m == RS_MODE_SHADOW ||
              m == RS_MODE_IRRADIANCE;
     f->diffuse = m == RS_MODE_FULL || m == RS_MODE_DIFFUSE;
+    f->lean_attributes = f->mobile && m != RS_MODE_REGIONS && m != RS_MODE_LOD && r->float_rt;
     f->shadows = f->lit && !v->no_shadows;
 
     const rs_splat_header *h = &r->cloud->hdr;
@@ -180,6 +257,7 @@ static const char *const prog_files[RS_PROG_COUNT][2] = {
     [RS_PROG_VISIBILITY] = {"visibility.vert.glsl", "visibility.frag.glsl"},
     [RS_PROG_PICK] = {"visibility.vert.glsl", "visibility.frag.glsl"},
     [RS_PROG_ATTRIBUTE] = {"attribute.vert.glsl", "attribute.frag.glsl"},
+    [RS_PROG_ATTRIBUTE_LEAN] = {"attribute.vert.glsl", "attribute.frag.glsl"},
     [RS_PROG_DIFFUSION] = {"diffusion.vert.glsl", "diffusion.frag.glsl"},
     [RS_PROG_RESOLVE] = {"fullscreen.vert.glsl", "diffusion_resolve.frag.glsl"},
     [RS_PROG_COMPOSITE] = {"fullscreen.vert.glsl", "composite.frag.glsl"},
@@ -189,6 +267,7 @@ static const char *const prog_files[RS_PROG_COUNT][2] = {
 static const char *const prog_defines[RS_PROG_COUNT] = {
     [RS_PROG_SHADOW] = "#define RS_SHADOW 1\n",
     [RS_PROG_PICK] = "#define RS_PICK 1\n",
+    [RS_PROG_ATTRIBUTE_LEAN] = "#define RS_ATTR_LEAN 1\n",
 };
 
 rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *out, rs_error *err)
@@ -325,6 +404,11 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
     r->float_rt = desc->caps->float_rt && !desc->force_no_float_targets;
     r->time_stages = desc->time_stages;
     r->radius_median = median_radius(c);
+    // Surface area from the radii: rouge-pack's radius is the distance to the 8th nearest neighbour, so
+    // a disk of that radius holds ~8 samples and each sample stands for pi r^2 / 8 of the surface.
+    double area = 0;
+    for (uint32_t i = 0; i < c->hdr.count; i++) area += (double)c->radius[i] * c->radius[i];
+    r->area_total = (float)(area * 3.14159265358979 / 8.0);
     // Until the makeup layer says otherwise, the pigment clamp is the whole 0..1 range.
     for (int ch = 0; ch < 3; ch++) r->makeup_uni.range_lo[ch] = 0.0f, r->makeup_uni.range_hi[ch] = 1.0f;
     float ext2 = 0;
@@ -368,14 +452,14 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
 
 static void release_targets(rs_renderer *r)
 {
-    GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_level, r->fbo_diffuse, r->fbo_out};
+    GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_diffuse, r->fbo_out};
     glDeleteFramebuffers((GLsizei)RS_COUNT_OF(fbos), fbos);
-    GLuint texs[] = {r->depth_tex, r->attr_tex[0], r->attr_tex[1], r->attr_tex[2],
-                     r->level_tex, r->diffuse_tex, r->out_tex};
+    GLuint texs[] = {r->depth_tex, r->attr_tex[0], r->attr_tex[1], r->attr_tex[2], r->diffuse_tex, r->out_tex};
     glDeleteTextures((GLsizei)RS_COUNT_OF(texs), texs);
-    r->fbo_vis = r->fbo_attr = r->fbo_level = r->fbo_diffuse = r->fbo_out = 0;
+    rs_render_level_release(r);
+    r->fbo_vis = r->fbo_attr = r->fbo_diffuse = r->fbo_out = 0;
     r->depth_tex = r->attr_tex[0] = r->attr_tex[1] = r->attr_tex[2] = 0;
-    r->level_tex = r->diffuse_tex = r->out_tex = 0;
+    r->diffuse_tex = r->out_tex = 0;
     r->tw = r->th = 0;
     r->have_frame = false;
 }
@@ -421,7 +505,6 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
     GLenum acc = r->float_rt ? GL_RGBA16F : GL_RGBA8;
     r->depth_tex = rs_render_texture(GL_DEPTH_COMPONENT32F, w, h);
     for (int i = 0; i < 3; i++) r->attr_tex[i] = rs_render_texture(acc, w, h);
-    r->level_tex = rs_render_texture(acc, w, h);
     r->diffuse_tex = rs_render_texture(acc, w, h);
     r->out_tex = rs_render_texture(GL_RGBA8, w, h);
     const char *acc_name = r->float_rt ? "RGBA16F" : "RGBA8";
@@ -435,7 +518,6 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
     } t[] = {
         {&r->fbo_vis, NULL, 0, r->depth_tex, "visibility target", "DEPTH_COMPONENT32F"},
         {&r->fbo_attr, r->attr_tex, 3, r->depth_tex, "attribute targets", acc_name},
-        {&r->fbo_level, &r->level_tex, 1, 0, "diffusion level target", acc_name},
         {&r->fbo_diffuse, &r->diffuse_tex, 1, 0, "diffuse target", acc_name},
         {&r->fbo_out, &r->out_tex, 1, 0, "output target", "RGBA8"},
     };
@@ -459,7 +541,10 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
 static size_t target_bytes(const rs_renderer *r)
 {
     size_t px = (size_t)r->tw * (size_t)r->th, acc = r->float_rt ? 8 : 4;
-    return px * (4 + 5 * acc + 4);
+    size_t bytes = px * (4 + 4 * acc + 4);
+    for (int i = 0; i < RS_LEVEL_DIVS; i++)
+        if (r->level_tex[i]) bytes += px * acc >> (2 * i);
+    return bytes;
 }
 
 // ---- the frame ----
@@ -534,10 +619,12 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
 
     r->have_frame = true;
     r->stats.splats_drawn = f.count;
+    r->stats.face_pixels = f.face_px;
     r->stats.kernel_count = nlevels;
     r->stats.used_points = !f.quads;
     r->stats.float_targets = r->float_rt;
-    size_t shadow_bytes = (size_t)r->shadow_size * (size_t)r->shadow_size * 4;
+    size_t shadow_bytes = 0;
+    for (int i = 0; i < 2; i++) shadow_bytes += (size_t)r->shadow[i].size * (size_t)r->shadow[i].size * 4;
     size_t pick_bytes = (size_t)r->pw * (size_t)r->ph * 8;
     r->stats.gpu_bytes = (size_t)r->cloud->hdr.count * 40 + target_bytes(r) + shadow_bytes + pick_bytes;
     r->stats.frame_ms = (rs_time_now() - t_start) * 1000.0;

@@ -77,8 +77,9 @@ typedef struct rs_view {
     float rho_s_scale;          // multiplies every rho_s (tests, paper Fig. 11); 0 means 1
     uint32_t max_splats;        // cap on the LOD prefix drawn (0: pipeline decides)
     int kernel_count;           // mobile pipeline: K Gaussians (0: default, 3)
-    float lod_density;          // mobile pipeline: main passes draw the LOD prefix nearest to this many
-                                // splats per pixel of the face's screen area (0: default, 1)
+    float lod_density;          // mobile pipeline: main passes draw the LOD prefix giving about this many
+                                // visible splats per pixel of the face's screen area, at most 2 LOD
+                                // levels (4x) below max_splats (0: default 0.3; docs/mobile.md)
     rs_splat_prim prim;         // primitive choice (AUTO by caps)
     float ambient;              // uniform sky irradiance added to every splat (linear, unshadowed); 0: none
     bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)

@@ -43,14 +43,18 @@ static void lod_palette(int levels, float out[24][3])
 rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
 {
     GLuint prog;
-    rs_result res = rs_render_program(r, RS_PROG_ATTRIBUTE, f->quads, &prog, err);
+    rs_result res = rs_render_program(r, f->lean_attributes ? RS_PROG_ATTRIBUTE_LEAN : RS_PROG_ATTRIBUTE, f->quads,
+                                      &prog, err);
     if (res != RS_OK) return res;
     const rs_camera *cam = &f->cam;
     const rs_splat_header *h = &r->cloud->hdr;
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_attr);
     glViewport(0, 0, cam->width, cam->height);
+    int targets = f->lean_attributes ? 2 : 3;
+    const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(targets, bufs);
     const GLfloat zero[4] = {0, 0, 0, 0};
-    for (int i = 0; i < 3; i++) glClearBufferfv(GL_COLOR, i, zero);
+    for (int i = 0; i < targets; i++) glClearBufferfv(GL_COLOR, i, zero);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);

@@ -29,6 +29,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform2f(rs_uloc(prog, "u_viewport"), (float)cam->width, (float)cam->height);
     glUniform1f(rs_uloc(prog, "u_eps"), f->eps);
     glUniform1i(rs_uloc(prog, "u_mode"), (int)v->mode);
+    glUniform1i(rs_uloc(prog, "u_lean"), f->lean_attributes ? 1 : 0);
     glUniform1i(rs_uloc(prog, "u_physical"), v->composite == RS_COMPOSITE_PHYSICAL ? 1 : 0);
     glUniform1f(rs_uloc(prog, "u_exposure"), v->exposure);
     glUniform1f(rs_uloc(prog, "u_linear_output"), v->linear_output ? 1.0f : 0.0f);

@@ -17,6 +17,7 @@ typedef enum rs_prog {
     RS_PROG_VISIBILITY,
     RS_PROG_PICK,
     RS_PROG_ATTRIBUTE,
+    RS_PROG_ATTRIBUTE_LEAN,  // two targets instead of three (the mobile pipeline's lit modes)
     RS_PROG_DIFFUSION,
     RS_PROG_SPLAT_COUNT,
     RS_PROG_RESOLVE = RS_PROG_SPLAT_COUNT,
@@ -67,13 +68,47 @@ typedef struct rs_diffusion_level {
     float weight[3];    // RGB weight of this level in D
     uint32_t count;     // LOD prefix drawn
     bool quads;         // instanced quads (the kernel sprite outgrows point sprites)
+    int res_div;        // the level is drawn at 1/res_div of the frame's resolution (1, 2 or 4)
 } rs_diffusion_level;
+
+// Level targets exist at full, half and quarter resolution (rs_diffusion_level.res_div 1, 2, 4).
+#define RS_LEVEL_DIVS 3
+
+// The mobile pipeline's defaults (render.c, render_diffusion.c; docs/mobile.md has the measurements).
+// Main passes: the LOD prefix nearest (in log) to this many visible splats per pixel of the face's screen
+// area (at 512x512 and the default framing: the 145k prefix of the 600k head, ~1.3 drawn splats per face
+// pixel), but never more than RS_MOBILE_MAX_LOD_STEPS LOD levels (each ~2x) below the max_splats cap:
+// mobile-vs-reference PSNR follows the decimation ratio whatever the view size (on the bundled head at
+// 512^2: 2x 45 dB, 4x 42 dB, 8x 38 dB, 16x 34 dB; 16x at 256^2 34 dB too).
+#define RS_LOD_DENSITY_DEFAULT 0.3f
+#define RS_MOBILE_MAX_LOD_STEPS 2
+// An even (Poisson-disk) LOD prefix closes the surface with radii of ~0.5 x sqrt(N / n) x the full
+// cloud's k-nearest-neighbour radii (measured: pinholes below 0.5 on the bundled head); the mobile
+// pipeline draws 0.55 of that (never less than the full cloud's radii). sqrt(N / n) itself (the
+// reference's rule) blurs the decimated image and grows its silhouette: 34.7 instead of 41.8 dB
+// against the reference at 512x512 with the 145k prefix.
+#define RS_MOBILE_COVER 0.55f
+#define RS_SHADOW_SIZE_REFERENCE 2048
+#define RS_SHADOW_SIZE_MOBILE 1024
+
+// A shadow map and what it was drawn for (cached while the light, LOD and radius stay the same); one per
+// pipeline so that switching pipelines (the bench's interleaved frames, the viewer's toggle) redraws none.
+typedef struct rs_shadow_map {
+    GLuint tex, fbo;
+    int size;
+    mat4 vp;                 // model -> light clip
+    float key[6];            // light dir, count, radius scale, valid
+    float radius;            // typical splat radius in the map, model units
+} rs_shadow_map;
 
 typedef struct rs_frame {
     rs_view view;            // with zero fields replaced by their defaults
     rs_camera cam;
     uint32_t count;          // splats in the main passes (an LOD prefix)
-    float radius_scale;      // rs_splat_lod_radius_scale(count)
+    float radius_scale;      // reference: rs_splat_lod_radius_scale(count); mobile: see RS_MOBILE_COVER
+    bool mobile;             // RS_PIPELINE_MOBILE
+    float face_px;           // mobile: estimated screen area of the face, pixels (render.c face_pixels)
+    int shadow_slot;         // which of the renderer's shadow maps (0 reference, 1 mobile)
     bool quads;              // main passes drawn as instanced quads
     float eps;               // visibility push along the view ray, model units
     bool lit;                // mode needs lights (shadow map, irradiance)
@@ -85,6 +120,7 @@ typedef struct rs_frame {
     mat4 shadow_matrix;      // view space -> light clip space
     float shadow_bias, shadow_offset, shadow_texel;
     float delta_weight[3];   // profile weight taken by per-pixel irradiance (stage 4's narrow Gaussians)
+    bool lean_attributes;    // stage 3 writes two targets: RT1 = (normal.xy, m, rho_s) (render_attribute.c)
 } rs_frame;
 
 struct rs_renderer {
@@ -103,16 +139,14 @@ struct rs_renderer {
 
     // Frame targets (width x height).
     int tw, th;
-    GLuint depth_tex, attr_tex[3], level_tex, diffuse_tex, out_tex;
-    GLuint fbo_vis, fbo_attr, fbo_level, fbo_diffuse, fbo_out;
+    GLuint depth_tex, attr_tex[3], diffuse_tex, out_tex;
+    GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_out;
+    GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;
 
-    // Shadow map, re-rendered only when the light or the LOD changes.
-    GLuint shadow_tex, fbo_shadow;
-    int shadow_size;
-    mat4 shadow_vp;             // model -> light clip
-    float shadow_key[5];        // light dir, count, valid
-    float shadow_radius;        // typical splat radius in the map, model units
+    // Shadow maps (reference, mobile), re-rendered only when the light or the LOD changes.
+    rs_shadow_map shadow[2];
+    float area_total;           // the cloud's surface area, model units^2 (render.c face_pixels)
 
     // ID buffer, re-rendered only when the view changes.
     int pw, ph;
@@ -122,10 +156,9 @@ struct rs_renderer {
 
     rs_makeup_uniforms makeup_uni;  // makeup.glsl's colour range
 
-    // Mobile profile cache (rs_profile_fit is ~1 ms).
-    rs_profile fit;
-    int fit_k;
-    float fit_footprint;
+    // Mobile profile cache, one per K (a fit takes milliseconds to tens of milliseconds).
+    rs_profile fit[RS_PROFILE_FIT_MAX + 1];
+    float fit_footprint[RS_PROFILE_FIT_MAX + 1];  // 0: none yet
 
     rs_render_stats stats;
 };
@@ -159,6 +192,7 @@ rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffus
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err);
 void rs_render_pick_release(rs_renderer *r);
 void rs_render_shadow_release(rs_renderer *r);
+void rs_render_level_release(rs_renderer *r);
 
 static inline GLint rs_uloc(GLuint prog, const char *name) { return glGetUniformLocation(prog, name); }
 

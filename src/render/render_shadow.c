@@ -2,37 +2,39 @@
 // an orthographic frustum fitted to the cloud's bounding sphere, drawn with the visibility pass's ray-disk
 // shader (no push). Lookups (shaders_es/shadow_lookup.glsl) use a normal offset and a depth bias of about
 // one splat radius (acne comes from neighbouring disks disagreeing by up to that much) and a 3x3 grid of
-// hardware 2x2 PCF. The map only depends on the light and the LOD, so it is cached across camera moves.
+// hardware 2x2 PCF. The map only depends on the light and the LOD, so it is cached across camera moves,
+// one per pipeline (the mobile one at half the resolution, from the mobile LOD prefix).
 #include "render/render_internal.h"
 
 #include <math.h>
 #include <string.h>
 
-// 2048^2 keeps a texel near 0.3 mm on the bundled bust (bounding sphere ~6 units, 47 mm/unit).
-#define SHADOW_SIZE 2048
+// Reference: 2048^2 keeps a texel near 0.3 mm on the bundled bust (bounding sphere ~6 units, 47 mm/unit).
+// Mobile: 1024^2 (RS_SHADOW_SIZE_MOBILE), texels of ~0.6 mm, still below the PCF penumbra (~8 texels).
 
 void rs_render_shadow_release(rs_renderer *r)
 {
-    glDeleteFramebuffers(1, &r->fbo_shadow);
-    glDeleteTextures(1, &r->shadow_tex);
-    r->fbo_shadow = r->shadow_tex = 0;
-    r->shadow_size = 0;
-    r->shadow_key[4] = 0;
+    for (int i = 0; i < 2; i++) {
+        rs_shadow_map *m = &r->shadow[i];
+        glDeleteFramebuffers(1, &m->fbo);
+        glDeleteTextures(1, &m->tex);
+        memset(m, 0, sizeof *m);
+    }
 }
 
-static rs_result ensure_map(rs_renderer *r, rs_error *err)
+static rs_result ensure_map(rs_renderer *r, rs_shadow_map *m, int want, rs_error *err)
 {
-    if (r->shadow_tex) return RS_OK;
-    int size = RS_MIN(SHADOW_SIZE, r->caps.max_texture_size);
-    r->shadow_tex = rs_render_texture(GL_DEPTH_COMPONENT32F, size, size);
+    if (m->tex) return RS_OK;
+    int size = RS_MIN(want, r->caps.max_texture_size);
+    m->tex = rs_render_texture(GL_DEPTH_COMPONENT32F, size, size);
     // Hardware PCF: compare mode + linear filtering gives a bilinear 2x2 comparison per lookup.
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glGenFramebuffers(1, &r->fbo_shadow);
-    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_shadow);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, r->shadow_tex, 0);
+    glGenFramebuffers(1, &m->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, m->tex, 0);
     GLenum none = GL_NONE;
     glDrawBuffers(1, &none);
     glReadBuffer(GL_NONE);
@@ -41,10 +43,12 @@ static rs_result ensure_map(rs_renderer *r, rs_error *err)
     rs_result res = rs_render_fbo_check(what, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (res != RS_OK) {
-        rs_render_shadow_release(r);
+        glDeleteFramebuffers(1, &m->fbo);
+        glDeleteTextures(1, &m->tex);
+        memset(m, 0, sizeof *m);
         return res;
     }
-    r->shadow_size = size;
+    m->size = size;
     return RS_OK;
 }
 
@@ -63,7 +67,8 @@ static void light_matrices(const rs_renderer *r, const vec3 L, mat4 view, mat4 p
 
 rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
 {
-    rs_result res = ensure_map(r, err);
+    rs_shadow_map *m = &r->shadow[f->shadow_slot];
+    rs_result res = ensure_map(r, m, f->mobile ? RS_SHADOW_SIZE_MOBILE : RS_SHADOW_SIZE_REFERENCE, err);
     if (res != RS_OK) return res;
     // The key light direction back in model space.
     vec3 L;
@@ -72,26 +77,26 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
     glm_mat3_mulv(inv_rot, f->key_dir, L);
     glm_vec3_normalize(L);
     uint32_t count = f->count;
-    float scale = rs_splat_lod_radius_scale(r->cloud, count);
+    float scale = f->radius_scale;
     float R = r->bound_radius;
-    float key[5] = {L[0], L[1], L[2], (float)count, 1.0f};
+    float key[6] = {L[0], L[1], L[2], (float)count, scale, 1.0f};
     bool cached = true;
-    for (int i = 0; i < 5; i++) cached = cached && fabsf(key[i] - r->shadow_key[i]) < 1e-6f;
+    for (int i = 0; i < 6; i++) cached = cached && fabsf(key[i] - m->key[i]) < 1e-6f;
 
     mat4 view, proj, inv_proj;
     light_matrices(r, L, view, proj);
     glm_mat4_inv(proj, inv_proj);
-    glm_mat4_mul(proj, view, r->shadow_vp);
+    glm_mat4_mul(proj, view, m->vp);
     if (!cached) {
         GLuint prog;
         bool quads = f->view.prim == RS_PRIM_QUADS;
-        float texels_per_unit = (float)r->shadow_size / (2.0f * R);
+        float texels_per_unit = (float)m->size / (2.0f * R);
         float size = 2.0f * r->cloud->hdr.radius_max * RS_COVERAGE * scale * texels_per_unit + 2.0f;
         if (f->view.prim == RS_PRIM_AUTO && size > r->caps.point_size_max) quads = true;
         res = rs_render_program(r, RS_PROG_SHADOW, quads, &prog, err);
         if (res != RS_OK) return res;
-        glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_shadow);
-        glViewport(0, 0, r->shadow_size, r->shadow_size);
+        glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
+        glViewport(0, 0, m->size, m->size);
         glDisable(GL_BLEND);
         glEnable(GL_DEPTH_TEST);
         glDepthFunc(GL_LESS);
@@ -99,32 +104,37 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
         glClear(GL_DEPTH_BUFFER_BIT);
         glUseProgram(prog);
         // Splats facing well away from the light are behind its front surface anyway.
-        rs_render_splat_uniforms(prog, view, proj, inv_proj, r->shadow_size, r->shadow_size, false, scale, -0.3f,
+        rs_render_splat_uniforms(prog, view, proj, inv_proj, m->size, m->size, false, scale, -0.3f,
                                  r->caps.point_size_max);
         glUniform1f(rs_uloc(prog, "u_eps"), 0.0f);
         rs_render_draw_splats(r, count, quads);
-        memcpy(r->shadow_key, key, sizeof key);
-        r->shadow_radius = r->radius_median * scale;
+        memcpy(m->key, key, sizeof key);
+        m->radius = r->radius_median * scale;
     }
     // Lookups come from view space: view -> model -> light clip.
-    glm_mat4_mul(r->shadow_vp, f->cam.inv_view, f->shadow_matrix);
-    f->shadow_texel = 1.0f / (float)r->shadow_size;
+    glm_mat4_mul(m->vp, f->cam.inv_view, f->shadow_matrix);
+    // The filter is sized in the reference map's texels whatever this map's size, so that the mobile
+    // pipeline's half-resolution map gives the same penumbra (its PCF taps are then 0.75 texels apart,
+    // still bilinear-smooth); only the quantisation term of the bias follows the map's own texels.
+    float texel = 2.0f * R / (float)m->size;
+    float texel_pcf = 2.0f * R / (float)RS_MIN(RS_SHADOW_SIZE_REFERENCE, r->caps.max_texture_size);
+    f->shadow_texel = texel_pcf / (2.0f * R);
     // A disk departs from the surface it samples by ~r^2 / 2R at its rim (curvature radius R ~ 0.3 of
     // the face height on cheeks and nose) plus r sin(3 deg) from normal noise: ~0.15 r on the bundled
     // head; a texel of quantisation on top. Depth bias in window units (the ortho range is 2.02 R).
-    float texel = 2.0f * R / (float)r->shadow_size;
-    f->shadow_bias = (0.15f * r->shadow_radius + texel) / (2.02f * R);
+    f->shadow_bias = (0.15f * m->radius + texel) / (2.02f * R);
     // Normal offset: a texel and a half (the PCF grid's step) plus the same disk departure.
-    f->shadow_offset = 1.5f * texel + 0.15f * r->shadow_radius;
+    f->shadow_offset = 1.5f * texel_pcf + 0.15f * m->radius;
     // The PCF grid reaches 3.25 texels sideways: on slopes that is depth too.
-    f->shadow_bias += 1.5f * texel / (2.02f * R);
+    f->shadow_bias += 1.5f * texel_pcf / (2.02f * R);
     return rs_gl_check("render: shadow map", err);
 }
 
 void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog)
 {
-    rs_render_bind_texture(RS_UNIT_SHADOW, f->shadows ? r->shadow_tex : 0);
-    glUniform1f(rs_uloc(prog, "u_shadow_on"), f->shadows && r->shadow_tex ? 1.0f : 0.0f);
+    GLuint tex = r->shadow[f->shadow_slot].tex;
+    rs_render_bind_texture(RS_UNIT_SHADOW, f->shadows ? tex : 0);
+    glUniform1f(rs_uloc(prog, "u_shadow_on"), f->shadows && tex ? 1.0f : 0.0f);
     glUniformMatrix4fv(rs_uloc(prog, "u_shadow_matrix"), 1, GL_FALSE, (const float *)f->shadow_matrix);
     glUniform1f(rs_uloc(prog, "u_shadow_texel"), f->shadow_texel);
     glUniform1f(rs_uloc(prog, "u_shadow_bias"), f->shadow_bias);
