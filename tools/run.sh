@@ -7,5 +7,4 @@ if [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; then
 fi
 out="$build/face.png"
 echo "rouge: no display (DISPLAY/WAYLAND_DISPLAY unset): rendering headlessly"
-"$build/rouge" render assets/face.rsf -o "$out" --size 768x768 --pipeline mobile || exit 1
-echo "rouge: wrote $out"
+exec "$build/rouge" render assets/face.rsf -o "$out" --size 768x768 --pipeline mobile
