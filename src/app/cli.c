@@ -42,6 +42,7 @@ static const opt opts[] = {
     {"--ambient", OPT_FLOAT, "X", "uniform sky light added to the irradiance (default 0.05)", 0, 10},
     {"--max-splats", OPT_INT, "N", "draw at most N splats (an LOD prefix)", 1, 2e9f},
     {"--kernels", OPT_INT, "K", "mobile pipeline: number of Gaussians (2..4, default 3)", 2, 4},
+    {"--lod-density", OPT_FLOAT, "D", "mobile pipeline: visible splats per face pixel (default 0.3)", 0.01f, 1000},
     {"--prim", OPT_ENUM, "P", "auto|points|quads: splat primitive", 0, 0},
     {"--strokes", OPT_PATH, "FILE", "replay a stroke file (painting) before rendering", 0, 0},
     {"--look", OPT_PATH, "FILE", "apply a saved look (makeup layer)", 0, 0},
@@ -141,6 +142,7 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--ambient")) w->ambient = f;
     else if (!strcmp(n, "--max-splats")) w->max_splats = (uint32_t)f;
     else if (!strcmp(n, "--kernels")) w->kernel_count = (int)f;
+    else if (!strcmp(n, "--lod-density")) w->lod_density = f;
     else if (!strcmp(n, "--strokes")) c->strokes = v;
     else if (!strcmp(n, "--look")) c->look = v;
     else if (!strcmp(n, "--save-look")) c->save_look = v;
