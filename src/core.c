@@ -104,6 +104,10 @@ rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, 
 
 rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err)
 {
+    // Only ever replace a regular file: renaming over /dev/null, a FIFO or a socket would destroy it.
+    struct stat st;
+    if (lstat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return rs_fail(err, RS_ERR_IO, "%s: cannot write: not a regular file", path);
     char tmp[4096];
     int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
     if (n < 0 || (size_t)n >= sizeof tmp) return rs_fail(err, RS_ERR_ARG, "%s: path too long", path);

@@ -42,6 +42,10 @@ head -c 1000 "$face" >"$tmp/trunc.rsf"
 expect cli_truncated_face 1 "trunc.rsf" "$rouge" render "$tmp/trunc.rsf" -o "$tmp/d.png"
 no_file cli_truncated_leaves_no_output "$tmp/d.png"
 expect cli_unwritable_output 1 "cannot write" "$rouge" render "$face" -o "$tmp/no/such/dir/e.png" --size 32x32 --max-splats 2000
+# A special file as output is refused, never replaced (as root, `-o /dev/null` would otherwise be).
+mkfifo "$tmp/fifo"
+expect cli_fifo_as_output 1 "not a regular file" "$rouge" render "$face" -o "$tmp/fifo" --size 32x32 --max-splats 2000
+if [ -p "$tmp/fifo" ]; then echo "ok - cli_fifo_output_is_left_alone"; else echo "FAIL - cli_fifo_output_is_left_alone: replaced"; fi
 # No GLES 3: point glvnd at no EGL vendor at all.
 expect cli_no_gles3_is_one_clear_line 1 "no GLES 3 context" \
     env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$rouge" render "$face" -o "$tmp/f.png" --size 32x32
