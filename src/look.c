@@ -265,9 +265,10 @@ rs_result rs_look_load(rs_makeup *mk, const char *path, rs_makeup_range *dirty, 
     r = rs_look_parse(data, len, &look, &inner);
     free(data);
     if (r != RS_OK) return rs_fail(err, r, "%s: %s", path, inner.msg);
-    r = rs_look_apply(look, mk, dirty, err);
+    r = rs_look_apply(look, mk, dirty, &inner);
     rs_look_destroy(look);
-    return r;
+    if (r != RS_OK) return rs_fail(err, r, "%s: %s", path, inner.msg);
+    return RS_OK;
 }
 
 // --- writing ---------------------------------------------------------------------------------------
