@@ -13,6 +13,7 @@
 // loaded on the same cloud replays to byte-identical records.
 #define _POSIX_C_SOURCE 200809L  // strtok_r
 #include "look.h"
+#include "textfile.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -48,42 +49,6 @@ static rs_result perr(parser *p, const char *fmt, ...)
     return rs_fail(p->err, RS_ERR_FORMAT, "line %u: %s", p->line, msg);
 }
 
-static bool parse_float(const char *s, float *out)
-{
-    char *end;
-    float v = strtof(s, &end);
-    if (end == s || *end != '\0' || !isfinite(v)) return false;
-    *out = v;
-    return true;
-}
-
-static bool parse_uint(const char *s, uint32_t max, uint32_t *out)
-{
-    if (*s < '0' || *s > '9') return false;
-    uint64_t v = 0;
-    for (; *s; s++) {
-        if (*s < '0' || *s > '9') return false;
-        v = v * 10 + (uint64_t)(*s - '0');
-        if (v > max) return false;
-    }
-    *out = (uint32_t)v;
-    return true;
-}
-
-static bool grow(void **ptr, uint32_t *cap, uint32_t need, size_t elem)
-{
-    if (need <= *cap) return true;
-    uint64_t c = RS_MAX((uint64_t)*cap * 2, 64u);
-    while (c < need) c *= 2;
-    size_t bytes;
-    if (c > UINT32_MAX || !rs_size_mul((size_t)c, elem, &bytes)) return false;
-    void *q = realloc(*ptr, bytes);
-    if (!q) return false;
-    *ptr = q;
-    *cap = (uint32_t)c;
-    return true;
-}
-
 static rs_result parse_stamp(parser *p, bool eraser, char **save)
 {
     rs_look *lk = p->look;
@@ -94,7 +59,7 @@ static rs_result parse_stamp(parser *p, bool eraser, char **save)
     for (int k = 0; k < 8; k++) {
         char *tok = strtok_r(NULL, " \t", save);
         if (!tok) return perr(p, "stamp: missing %s", names[k]);
-        if (!parse_float(tok, &v[k]) || fabsf(v[k]) > RS_LOOK_MAX_COORD)
+        if (!rs_text_parse_float(tok, &v[k]) || fabsf(v[k]) > RS_LOOK_MAX_COORD)
             return perr(p, "stamp: %s: '%.64s' is not a finite number within %g", names[k], tok, RS_LOOK_MAX_COORD);
     }
     if (!(v[6] > 0.0f)) return perr(p, "stamp: radius: %g, must be > 0", v[6]);
@@ -103,12 +68,12 @@ static rs_result parse_stamp(parser *p, bool eraser, char **save)
     if (!eraser) {
         char *tok = strtok_r(NULL, " \t", save);
         if (!tok) return perr(p, "stamp: missing cosmetic index");
-        if (!parse_uint(tok, UINT16_MAX, &cos) || cos >= lk->cosmetic_count)
+        if (!rs_text_parse_uint(tok, UINT16_MAX, &cos) || cos >= lk->cosmetic_count)
             return perr(p, "stamp: cosmetic: '%.32s' is not a defined cosmetic index (0..%d)", tok,
                         (int)lk->cosmetic_count - 1);
     }
     if (strtok_r(NULL, " \t", save)) return perr(p, "stamp: unexpected text after the last field");
-    if (!grow((void **)&lk->stamps, &p->stamp_cap, lk->stamp_count + 1, sizeof *lk->stamps))
+    if (!rs_text_grow((void **)&lk->stamps, &p->stamp_cap, lk->stamp_count + 1, sizeof *lk->stamps))
         return rs_fail(p->err, RS_ERR_NOMEM, "line %u: out of memory", p->line);
     lk->stamps[lk->stamp_count++] = (rs_makeup_applied){{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6], v[7],
                                                         (uint16_t)cos, eraser, p->stroke_empty};
@@ -139,7 +104,7 @@ static rs_result parse_line(parser *p, char *line)
     if (strcmp(kw, "face") == 0) {
         if (p->have_face) return perr(p, "face: given twice");
         char *tok = strtok_r(NULL, " \t", &save);
-        if (!tok || strncmp(tok, "height=", 7) != 0 || !parse_float(tok + 7, &lk->face_height) ||
+        if (!tok || strncmp(tok, "height=", 7) != 0 || !rs_text_parse_float(tok + 7, &lk->face_height) ||
             !(lk->face_height > 0.0f) || lk->face_height > RS_LOOK_MAX_COORD)
             return perr(p, "face: expected height=H with H > 0");
         if (strtok_r(NULL, " \t", &save)) return perr(p, "face: unexpected text");
@@ -149,12 +114,12 @@ static rs_result parse_line(parser *p, char *line)
     if (strcmp(kw, "cosmetic") == 0) {
         char *tok = strtok_r(NULL, " \t", &save);
         uint32_t idx;
-        if (!tok || !parse_uint(tok, RS_LOOK_MAX_COSMETICS, &idx) || idx != lk->cosmetic_count)
+        if (!tok || !rs_text_parse_uint(tok, RS_LOOK_MAX_COSMETICS, &idx) || idx != lk->cosmetic_count)
             return perr(p, "cosmetic: index must be %u (cosmetics are numbered in order)", lk->cosmetic_count);
         if (idx >= RS_LOOK_MAX_COSMETICS) return perr(p, "cosmetic: more than %d", RS_LOOK_MAX_COSMETICS);
         char *rest = strtok_r(NULL, "", &save);
         if (!rest) return perr(p, "cosmetic %u: missing definition", idx);
-        if (!grow((void **)&lk->cosmetics, &p->cosmetic_cap, lk->cosmetic_count + 1, sizeof *lk->cosmetics))
+        if (!rs_text_grow((void **)&lk->cosmetics, &p->cosmetic_cap, lk->cosmetic_count + 1, sizeof *lk->cosmetics))
             return rs_fail(p->err, RS_ERR_NOMEM, "line %u: out of memory", p->line);
         rs_error inner = {0};
         if (rs_cosmetic_parse(rest, &lk->cosmetics[idx], &inner) != RS_OK) return perr(p, "%s", inner.msg);
@@ -171,37 +136,14 @@ rs_result rs_look_parse(const void *data, size_t len, rs_look **out, rs_error *e
     rs_look *lk = calloc(1, sizeof *lk);
     if (!lk) return rs_fail(err, RS_ERR_NOMEM, "look: out of memory");
     parser p = {.look = lk, .err = err};
-    const char *text = data;
+    rs_text_reader t = {.data = data, .len = len};
     bool header = false;
     rs_result r = RS_OK;
-    char buf[RS_LOOK_MAX_LINE + 1];
-    for (size_t pos = 0; pos < len && r == RS_OK;) {
-        p.line++;
-        const char *start = text + pos;
-        const char *nl = memchr(start, '\n', len - pos);
-        size_t n = nl ? (size_t)(nl - start) : len - pos;
-        pos += n + (nl ? 1 : 0);
-        if (n > 0 && start[n - 1] == '\r') n--;
-        if (n > RS_LOOK_MAX_LINE) {
-            r = perr(&p, "longer than %d bytes", RS_LOOK_MAX_LINE);
-            break;
-        }
-        if (memchr(start, '\0', n)) {
-            r = perr(&p, "NUL byte");
-            break;
-        }
-        memcpy(buf, start, n);
-        buf[n] = '\0';
-        char *line = buf + strspn(buf, " \t");
-        if (*line == '\0' || *line == '#') continue;
+    char buf[RS_LOOK_MAX_LINE + 1], *line;
+    while (r == RS_OK && rs_text_next_line(&t, buf, sizeof buf, &line, &r, err)) {
+        p.line = t.line;
         if (!header) {
-            char *save = NULL;
-            const char *magic = strtok_r(line, " \t", &save), *ver = strtok_r(NULL, " \t", &save);
-            uint32_t version = 0;
-            if (strcmp(magic, "rouge-look") != 0 || !ver || strtok_r(NULL, " \t", &save))
-                r = perr(&p, "not a look file (expected 'rouge-look %d')", RS_LOOK_VERSION);
-            else if (!parse_uint(ver, 1000000, &version) || version != RS_LOOK_VERSION)
-                r = perr(&p, "version '%.16s' not supported (this build reads %d)", ver, RS_LOOK_VERSION);
+            r = rs_text_check_header(line, "rouge-look", RS_LOOK_VERSION, "look file", t.line, err);
             header = true;
             continue;
         }

@@ -3,6 +3,7 @@
 // finite and in range, one-line errors with the line number.
 #define _POSIX_C_SOURCE 200809L  // strtok_r
 #include "strokes.h"
+#include "textfile.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -79,20 +80,6 @@ static rs_result check_sample(const rs_strokes_sample *s, const rs_strokes_sampl
     return RS_OK;
 }
 
-static bool grow(void **p, uint32_t *cap, uint32_t need, size_t elem)
-{
-    if (need <= *cap) return true;
-    uint64_t c = RS_MAX((uint64_t)*cap * 2, 16u);
-    while (c < need) c *= 2;
-    size_t bytes;
-    if (c > UINT32_MAX || !rs_size_mul((size_t)c, elem, &bytes)) return false;
-    void *q = realloc(*p, bytes);
-    if (!q) return false;
-    *p = q;
-    *cap = (uint32_t)c;
-    return true;
-}
-
 // --- recording -----------------------------------------------------------------------------------
 
 rs_result rs_strokes_begin(rs_strokes *doc, const rs_strokes_view *view, const rs_strokes_brush *brush,
@@ -105,7 +92,7 @@ rs_result rs_strokes_begin(rs_strokes *doc, const rs_strokes_view *view, const r
     if (doc->open) rs_strokes_end(doc);
     if (doc->count >= RS_STROKES_MAX_STROKES)
         return rs_fail(err, RS_ERR_LIMIT, "strokes: more than %d strokes", RS_STROKES_MAX_STROKES);
-    if (!grow((void **)&doc->strokes, &doc->stroke_cap, doc->count + 1, sizeof *doc->strokes))
+    if (!rs_text_grow((void **)&doc->strokes, &doc->stroke_cap, doc->count + 1, sizeof *doc->strokes))
         return rs_fail(err, RS_ERR_NOMEM, "strokes: out of memory");
     doc->strokes[doc->count++] = (rs_strokes_stroke){*view, *brush, *cosmetic, doc->sample_count, 0};
     doc->open = true;
@@ -120,7 +107,7 @@ rs_result rs_strokes_add_sample(rs_strokes *doc, const rs_strokes_sample *sample
     if (r != RS_OK) return r;
     if (doc->sample_count >= RS_STROKES_MAX_SAMPLES)
         return rs_fail(err, RS_ERR_LIMIT, "sample: more than %u samples in the file", RS_STROKES_MAX_SAMPLES);
-    if (!grow((void **)&doc->samples, &doc->sample_cap, doc->sample_count + 1, sizeof *doc->samples))
+    if (!rs_text_grow((void **)&doc->samples, &doc->sample_cap, doc->sample_count + 1, sizeof *doc->samples))
         return rs_fail(err, RS_ERR_NOMEM, "strokes: out of memory");
     doc->samples[doc->sample_count++] = *sample;
     st->sample_count++;
@@ -170,28 +157,6 @@ static rs_result relabel(parser *p, rs_result r, const rs_error *inner)
     return rs_fail(p->err, r, "line %u: %s", p->line, inner->msg);
 }
 
-static bool parse_float(const char *s, float *out)
-{
-    char *end;
-    float v = strtof(s, &end);
-    if (end == s || *end != '\0' || !isfinite(v)) return false;
-    *out = v;
-    return true;
-}
-
-static bool parse_uint(const char *s, uint32_t max, uint32_t *out)
-{
-    if (*s < '0' || *s > '9') return false;
-    uint64_t v = 0;
-    for (; *s; s++) {
-        if (*s < '0' || *s > '9') return false;
-        v = v * 10 + (uint64_t)(*s - '0');
-        if (v > max) return false;
-    }
-    *out = (uint32_t)v;
-    return true;
-}
-
 // Splits "key=value"; false when there is no '='.
 static bool split_kv(char *tok, char **key, char **val)
 {
@@ -228,12 +193,12 @@ static rs_result parse_view(parser *p, char **save)
             ok = x != NULL;
             if (ok) {
                 *x = '\0';
-                ok = parse_uint(val, RS_STROKES_MAX_SIZE_PX, &v.width_px) &&
-                     parse_uint(x + 1, RS_STROKES_MAX_SIZE_PX, &v.height_px);
+                ok = rs_text_parse_uint(val, RS_STROKES_MAX_SIZE_PX, &v.width_px) &&
+                     rs_text_parse_uint(x + 1, RS_STROKES_MAX_SIZE_PX, &v.height_px);
             }
         } else {
             float *f[] = {&v.yaw_deg, &v.pitch_deg, &v.zoom, &v.fov_deg};
-            ok = parse_float(val, f[k]);
+            ok = rs_text_parse_float(val, f[k]);
         }
         if (!ok) return perr(p, "view: %s: bad value '%.64s'", key, val);
     }
@@ -262,15 +227,15 @@ static rs_result parse_brush(parser *p, char **save)
         bool ok;
         uint32_t flag = 0;
         if (k == 0) {
-            ok = parse_float(val, &b.size_rel);
+            ok = rs_text_parse_float(val, &b.size_rel);
         } else if (k == 1) {
-            ok = parse_float(val, &b.opacity);
+            ok = rs_text_parse_float(val, &b.opacity);
         } else if (k == 2) {
             int m = key_index(val, pressure_names, RS_MAKEUP_PRESSURE_COUNT);
             ok = m >= 0;
             if (ok) b.pressure = (rs_makeup_pressure)m;
         } else {
-            ok = parse_uint(val, 1, &flag);
+            ok = rs_text_parse_uint(val, 1, &flag);
             if (k == 3) b.mirror = flag;
             else b.eraser = flag;
         }
@@ -291,7 +256,7 @@ static rs_result parse_sample(parser *p, char **save)
     for (int k = 0; k < 4; k++) {
         char *tok = strtok_r(NULL, " \t", save);
         if (!tok) return perr(p, "sample: needs 4 numbers (t x y pressure), got %d", k);
-        if (!parse_float(tok, &v[k])) return perr(p, "sample: value %d: '%.64s' is not a finite number", k + 1, tok);
+        if (!rs_text_parse_float(tok, &v[k])) return perr(p, "sample: value %d: '%.64s' is not a finite number", k + 1, tok);
     }
     if (strtok_r(NULL, " \t", save)) return perr(p, "sample: more than 4 numbers");
     rs_strokes_sample s = {v[0], v[1], v[2], v[3]};
@@ -347,36 +312,13 @@ rs_result rs_strokes_parse(const void *data, size_t len, rs_strokes **out, rs_er
     rs_result r = rs_strokes_create(&doc, err);
     if (r != RS_OK) return r;
     parser p = {.doc = doc, .err = err};
-    const char *text = data;
+    rs_text_reader t = {.data = data, .len = len};
     bool header = false;
-    char buf[RS_STROKES_MAX_LINE + 1];
-    for (size_t pos = 0; pos < len && r == RS_OK;) {
-        p.line++;
-        const char *start = text + pos;
-        const char *nl = memchr(start, '\n', len - pos);
-        size_t n = nl ? (size_t)(nl - start) : len - pos;
-        pos += n + (nl ? 1 : 0);
-        if (n > 0 && start[n - 1] == '\r') n--;
-        if (n > RS_STROKES_MAX_LINE) {
-            r = perr(&p, "longer than %d bytes", RS_STROKES_MAX_LINE);
-            break;
-        }
-        if (memchr(start, '\0', n)) {
-            r = perr(&p, "NUL byte");
-            break;
-        }
-        memcpy(buf, start, n);
-        buf[n] = '\0';
-        char *line = buf + strspn(buf, " \t");
-        if (*line == '\0' || *line == '#') continue;
+    char buf[RS_STROKES_MAX_LINE + 1], *line;
+    while (r == RS_OK && rs_text_next_line(&t, buf, sizeof buf, &line, &r, err)) {
+        p.line = t.line;
         if (!header) {
-            char *save = NULL;
-            const char *magic = strtok_r(line, " \t", &save), *ver = strtok_r(NULL, " \t", &save);
-            uint32_t version = 0;
-            if (strcmp(magic, "rouge-strokes") != 0 || !ver || strtok_r(NULL, " \t", &save))
-                r = perr(&p, "not a stroke file (expected 'rouge-strokes %d')", RS_STROKES_VERSION);
-            else if (!parse_uint(ver, 1000000, &version) || version != RS_STROKES_VERSION)
-                r = perr(&p, "version '%.16s' not supported (this build reads %d)", ver, RS_STROKES_VERSION);
+            r = rs_text_check_header(line, "rouge-strokes", RS_STROKES_VERSION, "stroke file", t.line, err);
             header = true;
             continue;
         }
