@@ -2,8 +2,8 @@
 #
 # Layout of outputs (all under $(BUILD), git-ignored):
 #   rouge, rouge-pack, rouge-imgdiff     programs
-#   librouge.a                           src/ (everything but src/app)
-#   libpack.a                            tools/ library parts of the converter (PLY reader, ...)
+#   librouge.a                           src/ (the library: no window-system or UI code)
+#   libpack.a                            tools/pack/: the converter library (PLY reader, ...)
 #   gen/shaders.c                        shaders_es/*.glsl embedded at build time
 #   tests/test_*                         one test program per tests/test_*.c
 
@@ -18,20 +18,23 @@ LDFLAGS  := $(EXTRA_LDFLAGS)
 PKG_CFLAGS := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS   := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 
-LIB_SRC   := $(shell find src -name '*.c' -not -path 'src/app/*' | sort)
-APP_SRC   := $(sort $(wildcard src/app/*.c))
+LIB_SRC   := $(shell find src -name '*.c' | sort)
+APP_SRC   := $(sort $(wildcard app/*.c))
 TOOL_PROG := $(sort $(wildcard tools/rouge_*.c))
-TOOL_LIB  := $(filter-out $(TOOL_PROG) tools/embed_shaders.c,$(sort $(wildcard tools/*.c)))
+TOOL_LIB  := $(sort $(wildcard tools/pack/*.c))
 TEST_SRC  := $(sort $(wildcard tests/test_*.c))
 SHADERS   := $(sort $(wildcard shaders_es/*.glsl))
 
 LIB_OBJ  := $(LIB_SRC:%.c=$(BUILD)/obj/%.o) $(BUILD)/obj/gen/shaders.o
 APP_OBJ  := $(APP_SRC:%.c=$(BUILD)/obj/%.o)
+APPLIB_OBJ := $(filter-out $(BUILD)/obj/app/main.o,$(APP_OBJ))
 TLIB_OBJ := $(TOOL_LIB:%.c=$(BUILD)/obj/%.o)
 TESTS    := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 PROGS    := $(BUILD)/rouge $(TOOL_PROG:tools/rouge_%.c=$(BUILD)/rouge-%)
 
 LIBS := $(BUILD)/libpack.a $(BUILD)/librouge.a $(PKG_LIBS) -lm
+# Tests also link the app's parts (UI, viewer, CLI) through libapp.a.
+TEST_LIBS := $(BUILD)/libapp.a $(LIBS)
 
 .PHONY: all deps run test bench asan fuzz figures clean
 all: $(PROGS) $(TESTS)
@@ -40,9 +43,22 @@ all: $(PROGS) $(TESTS)
 deps:
 	@sh tools/deps.sh
 
-$(BUILD)/obj/%.o: %.c
+# Include paths say who may use what: the library sees only src/; the app adds app/, the tools tools/.
+$(BUILD)/obj/src/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -c $< -o $@
+
+$(BUILD)/obj/app/%.o: app/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -Iapp -c $< -o $@
+
+$(BUILD)/obj/tools/%.o: tools/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -Itools -c $< -o $@
+
+$(BUILD)/obj/tests/%.o: tests/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -Iapp -Itools -Itests -c $< -o $@
 
 # Shaders are embedded at build time so an installed binary needs no shader directory.
 $(BUILD)/embed_shaders: tools/embed_shaders.c
@@ -61,6 +77,10 @@ $(BUILD)/librouge.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
+$(BUILD)/libapp.a: $(APPLIB_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
 $(BUILD)/libpack.a: $(TLIB_OBJ)
 	@mkdir -p $(dir $@)
 	@rm -f $@
@@ -72,9 +92,11 @@ $(BUILD)/rouge: $(APP_OBJ) $(BUILD)/librouge.a $(BUILD)/libpack.a
 $(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a $(BUILD)/libpack.a
 	$(CC) $(CFLAGS) $< $(LIBS) $(LDFLAGS) -o $@
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(BUILD)/obj/tests/harness.o $(BUILD)/librouge.a $(BUILD)/libpack.a
+TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(sort $(wildcard tests/support/*.c)))
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $< $(BUILD)/obj/tests/harness.o $(LIBS) $(LDFLAGS) -o $@
+	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(TEST_LIBS) $(LDFLAGS) -o $@
 
 run: deps
 	@$(MAKE) --no-print-directory all

@@ -1,6 +1,6 @@
 // makeup.glsl — composes the makeup layer over the base skin (paper eq. 2), #include'd by the
 // attribute-splat vertex shader (GLSL ES 3.00; no #version here). CPU mirror: rs_makeup_apply_cpu in
-// src/makeup.c, which must do the same operations in the same order.
+// src/makeup/makeup.c, which must do the same operations in the same order.
 //
 // The record (rs_makeup_gpu, one per splat, uploaded as a uvec2 attribute):
 //   rec.x = r | g << 8 | b << 16 | colour_i << 24     cosmetic colour Cp (sRGB8), colour intensity I

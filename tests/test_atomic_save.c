@@ -4,8 +4,8 @@
 // a torn mix, an empty file or missing. A control runs the same loop on a plain fopen/fwrite writer and
 // must catch it tearing the file, which shows the kill loop really lands in the middle of writes.
 #define _POSIX_C_SOURCE 200809L
-#include "harness.h"
-#include "look.h"
+#include "support/harness.h"
+#include "formats/look.h"
 
 #include <dirent.h>
 #include <errno.h>

@@ -1,6 +1,6 @@
 // test_gl.c — the GL foundation: headless GLES 3 context, embedded shaders and their error messages,
 // and a known scene rendered to an FBO compared with a committed golden image.
-#include "harness.h"
+#include "support/harness.h"
 #include "gl/gl.h"
 #include "gl/shader.h"
 

@@ -1,6 +1,6 @@
-// test_image.c — PNG I/O and the image metrics (src/image.c).
+// test_image.c — PNG I/O and the image metrics (src/core/image.c).
 #define _POSIX_C_SOURCE 200809L
-#include "harness.h"
+#include "support/harness.h"
 
 #include <errno.h>
 #include <math.h>

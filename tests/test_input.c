@@ -1,6 +1,6 @@
-// test_input.c — pointer input (src/input.c): stroke smoothing and resampling, gestures.
-#include "harness.h"
-#include "input.h"
+// test_input.c — pointer input (src/paint/input.c): stroke smoothing and resampling, gestures.
+#include "support/harness.h"
+#include "paint/input.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -1,7 +1,7 @@
-// test_look.c — look files (src/look.c): save/load round trip, loading on another LOD, hostile input.
+// test_look.c — look files (src/formats/look.c): save/load round trip, loading on another LOD, hostile input.
 #define _POSIX_C_SOURCE 200809L
-#include "harness.h"
-#include "look.h"
+#include "support/harness.h"
+#include "formats/look.h"
 
 #include <dirent.h>
 #include <math.h>

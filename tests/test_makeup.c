@@ -1,7 +1,7 @@
-// test_makeup.c — the makeup layer (src/makeup.c): eq. 2/3 arithmetic, composition, strokes, eraser,
+// test_makeup.c — the makeup layer (src/makeup/makeup.c): eq. 2/3 arithmetic, composition, strokes, eraser,
 // undo/redo, mirror, brush sizes, spacing invariance, finishes, grid gathering. Synthetic clouds only.
-#include "harness.h"
-#include "makeup.h"
+#include "support/harness.h"
+#include "makeup/makeup.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -4,7 +4,7 @@
 // its own LOD prefix), the K = 3 fit at a shadow edge, the LOD choice by projected density, the bare
 // (albedo) floor skipping shadows and diffusion, and the usual robustness checks on the new paths.
 // The bench (make bench) runs the whole set: 8 views x 2 lights x 2 modes.
-#include "harness.h"
+#include "support/harness.h"
 #include "render/render.h"
 
 #include <math.h>

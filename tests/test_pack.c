@@ -1,8 +1,8 @@
-// test_pack.c — rouge-pack's library (tools/pack.h): neighbours, normals, radii, LOD order, mesh
+// test_pack.c — rouge-pack's library (tools/pack/pack.h): neighbours, normals, radii, LOD order, mesh
 // sampling, the face frame and regions, and whole conversions of every PLY fixture.
 #define _POSIX_C_SOURCE 200809L
-#include "harness.h"
-#include "../tools/pack.h"
+#include "support/harness.h"
+#include "pack/pack.h"
 
 #include <dirent.h>
 #include <math.h>

@@ -1,6 +1,6 @@
 // test_paint_render.c — issue 6 acceptance on the real renderer: committed stroke files are replayed
 // through the paint session with picking from the renderer's ID buffer (as `rouge render --strokes`
-// does, src/app/paint_cmd.c), the makeup layer is uploaded by its dirty ranges, and the rendered images
+// does, app/paint_cmd.c), the makeup layer is uploaded by its dirty ranges, and the rendered images
 // are checked: where the paint lands, how brush size and foundation shade change it, what gloss and
 // powder do to the specular image, that undo, the eraser and looks restore images exactly, that mirror
 // painting is symmetric, and that the GLSL makeup compose equals its CPU mirror.
@@ -11,9 +11,9 @@
 // the drawn prefix shows. "Painted mask" below means the pixels whose colour differs from the bare
 // render of the same view by more than MASK_T levels in some channel. RS_TEST_VERBOSE=1 prints the
 // measured values. About 15 s on llvmpipe.
-#include "harness.h"
-#include "look.h"
-#include "paint.h"
+#include "support/harness.h"
+#include "formats/look.h"
+#include "paint/paint.h"
 #include "render/render.h"
 #include "gl/shader.h"
 
@@ -125,7 +125,7 @@ static rs_makeup *new_layer(const rs_splat_cloud *cloud)
     return mk;
 }
 
-// The picker sees the renderer through the view the stroke was recorded with (src/app/paint_cmd.c).
+// The picker sees the renderer through the view the stroke was recorded with (app/paint_cmd.c).
 typedef struct picker_ctx {
     rs_view view;
 } picker_ctx;
@@ -750,7 +750,7 @@ static bool lod_cloud(uint32_t n, rs_splat_cloud *out)
 // Lips, cheek and forehead painted, saved as a look, loaded into a fresh layer on the same cloud: the
 // render is bit-identical. Loaded on a cloud that is only the drawn LOD (37k splats) and shown at that
 // LOD, it matches the full-cloud render within 3 levels on all but 0.1 % of pixels, max 8 (measured:
-// 0.003 %, max 4): each cloud computes its own skin-detail ratios and colour range (src/makeup.c)
+// 0.003 %, max 4): each cloud computes its own skin-detail ratios and colour range (src/makeup/makeup.c)
 // from its own splats, so the records differ slightly.
 static void test_saved_look_renders_identically_on_the_same_and_a_coarser_lod(void)
 {

@@ -2,8 +2,8 @@
 // of malformed input fails with a one-line message naming what and where, without crashing (ASan).
 // Fixtures: tests/fixtures/ply/ (see its README.md); malformed variants are derived here in memory.
 #define _POSIX_C_SOURCE 200809L
-#include "harness.h"
-#include "../tools/ply.h"
+#include "support/harness.h"
+#include "pack/ply.h"
 
 #include <dirent.h>
 #include <math.h>

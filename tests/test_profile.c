@@ -1,6 +1,6 @@
-// test_profile.c — the six-Gaussian skin profile and its K-Gaussian fits (src/profile.h).
-#include "harness.h"
-#include "profile.h"
+// test_profile.c — the six-Gaussian skin profile and its K-Gaussian fits (src/render/profile.h).
+#include "support/harness.h"
+#include "render/profile.h"
 
 #include <math.h>
 #include <string.h>

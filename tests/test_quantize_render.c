@@ -6,7 +6,7 @@
 // to one quantization step in every field (position, octahedral normal, log radius) and re-encoded in a
 // new bounding box: the float data and its quantization differ by at most half a step, this test by up
 // to a whole step.
-#include "harness.h"
+#include "support/harness.h"
 #include "render/render.h"
 
 #include <math.h>

@@ -3,7 +3,7 @@
 // at 256x256 or less so each image costs well under a second on llvmpipe.
 //
 // Lit-image checks read linear output (rs_view.linear_output) so sums and ratios are in light units.
-#include "harness.h"
+#include "support/harness.h"
 #include "render/render.h"
 
 #include <math.h>

@@ -1,7 +1,7 @@
 // test_splat.c — the splat cloud and the .rsf format: quantisation bounds per field, byte-exact round
 // trips, the documented layout (docs/rsf.md), and a loader that rejects every malformed file cleanly.
 #define _POSIX_C_SOURCE 200809L
-#include "harness.h"
+#include "support/harness.h"
 #include "splat/splat.h"
 
 #include <float.h>

@@ -1,8 +1,8 @@
-// test_strokes.c — stroke files (src/strokes.c), cosmetic text (src/cosmetics.c) and the paint session
-// that records and replays them (src/paint.c) against a mock picker.
-#include "harness.h"
-#include "paint.h"
-#include "strokes.h"
+// test_strokes.c — stroke files (src/formats/strokes.c), cosmetic text (src/makeup/cosmetics.c) and the paint session
+// that records and replays them (src/paint/paint.c) against a mock picker.
+#include "support/harness.h"
+#include "paint/paint.h"
+#include "formats/strokes.h"
 
 #include <math.h>
 #include <stdio.h>

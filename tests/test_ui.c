@@ -1,7 +1,7 @@
 // test_ui.c — the viewer's UI toolkit: the bitmap font, toolbar layout (touch-target sizes, no overlaps,
 // fits the window, hit-testing), widget input (taps, slider drags, routing presses between UI and scene)
 // and a headless render of the toolbar compared with a golden image.
-#include "harness.h"
+#include "support/harness.h"
 #include "gl/gl.h"
 #include "ui.h"
 

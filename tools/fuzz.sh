@@ -4,10 +4,10 @@
 # a scratch directory, seeded by copying.
 #
 #   harness                  parser                           seeds
-#   tools/fuzz/fuzz_ply.c    rs_ply_load_memory (tools/ply.c)  tests/fixtures/ply
+#   tools/fuzz/fuzz_ply.c    rs_ply_load_memory (tools/pack/ply.c)  tests/fixtures/ply
 #   tools/fuzz/fuzz_rsf.c    rs_splat_load_memory (src/splat)  tests/fixtures/rsf
-#   tools/fuzz/fuzz_strokes.c rs_strokes_parse (src/strokes.c) tests/fixtures/strokes
-#   tools/fuzz/fuzz_look.c   rs_look_parse + apply (src/look.c) tests/fixtures/looks
+#   tools/fuzz/fuzz_strokes.c rs_strokes_parse (src/formats/strokes.c) tests/fixtures/strokes
+#   tools/fuzz/fuzz_look.c   rs_look_parse + apply (src/formats/look.c) tests/fixtures/looks
 # plus, for each, the inputs kept from earlier crashes: tests/fixtures/bad/fuzz/<name>/ (run first, as
 # regression tests; the ordinary test suite also feeds them to the real programs, tests/test_robustness.sh).
 #

@@ -13,7 +13,7 @@
 //   build/rouge-bench --build build [--data ../shared/data] [--quick] [--face assets/face.rsf]
 #define _DEFAULT_SOURCE  // wait4 (per-child peak memory)
 
-#include "makeup.h"
+#include "makeup/makeup.h"
 #include "render/render.h"
 #include "splat/splat.h"
 
@@ -395,7 +395,7 @@ static void memory_row(bench *b)
         rs_view v = rs_view_defaults();
         v.width = 1280, v.height = 720;
         rs_result res = rs_splat_load(b->face, &c, &err);
-        if (!res) res = rs_gl_create(&(rs_gl_desc){.kind = RS_GL_HEADLESS}, &gl, &err);
+        if (!res) res = rs_gl_create(&(rs_gl_desc){0}, &gl, &err);
         if (!res) res = rs_render_create(&(rs_render_desc){.cloud = c, .caps = rs_gl_get_caps(gl)}, &r, &err);
         if (!res) res = rs_render_image(r, &v, &img, &err);
         _exit(res ? 1 : 0);  // no cleanup: the peak is what we measure
@@ -758,7 +758,7 @@ int main(int argc, char **argv)
 
     rs_gl_context *gl = NULL;
     rs_renderer *r = NULL;
-    if (rs_gl_create(&(rs_gl_desc){.kind = RS_GL_HEADLESS}, &gl, &err) != RS_OK ||
+    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK ||
         rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r, &err) != RS_OK) {
         snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "n/a (%s)", err.msg);
         add_row(b, "frame times, quality, GPU bytes", NULL, "n/a (no GLES 3 context)");

@@ -1,9 +1,9 @@
-// rouge_imgdiff.c — rouge-imgdiff: compares two PNGs with the metrics image tests use (see src/image.h).
+// rouge_imgdiff.c — rouge-imgdiff: compares two PNGs with the metrics image tests use (see src/core/image.h).
 //
 // Prints one metric per line ("psnr_db 43.21", "ssim 0.987612", ...). Exit status: 0 when compared (and
 // within the optional tolerances), 1 when --max-frac or --min-psnr is not met, 2 on bad input or usage,
 // with one "rouge-imgdiff: <error>" line on stderr.
-#include "image.h"
+#include "core/image.h"
 
 #include <errno.h>
 #include <math.h>

@@ -1,10 +1,10 @@
 // rouge_pack.c — rouge-pack: converts a PLY scan (point cloud or textured mesh) into an .rsf splat file,
-// and prints what an .rsf holds (see tools/pack.h for the steps, docs/rsf.md for the format).
+// and prints what an .rsf holds (see tools/pack/pack.h for the steps, docs/rsf.md for the format).
 //
 // Exit status: 0 done, 1 the conversion or a file failed, 2 usage. Errors are one "rouge-pack: ..." line
 // on stderr; a progress bar goes to stderr only when it is a terminal; the summary goes to stdout.
 #define _POSIX_C_SOURCE 200809L
-#include "pack.h"
+#include "pack/pack.h"
 
 #include <errno.h>
 #include <math.h>

@@ -1,8 +1,8 @@
 // rouge_profile.c — rouge-profile: fits K Gaussians to the six-Gaussian skin profile, prints the fit and its error.
 //
-// This is where the README's and the bench's kernel numbers come from (src/profile.h does the work; the renderer
+// This is where the README's and the bench's kernel numbers come from (src/render/profile.h does the work; the renderer
 // runs the same fit at start-up). Exit status: 0 done, 2 bad usage, with one "rouge-profile: <error>" line.
-#include "profile.h"
+#include "render/profile.h"
 
 #include <errno.h>
 #include <math.h>

@@ -3,13 +3,11 @@
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
-#define GLFW_INCLUDE_NONE
-#include <GLFW/glfw3.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-// Under AddressSanitizer the driver stays mapped at exit: Mesa unloads it in eglTerminate/glfwTerminate,
+// Under AddressSanitizer the driver stays mapped at exit: Mesa unloads it in eglTerminate,
 // after which LeakSanitizer cannot name (and tests/lsan.supp cannot suppress) the driver's own leaks.
 #if defined(__SANITIZE_ADDRESS__)
 #define RS_GL_KEEP_DRIVER 1
@@ -21,7 +19,6 @@ struct rs_gl_context {
     rs_gl_caps caps;
     EGLDisplay dpy;
     EGLContext ctx;
-    GLFWwindow *window;
 };
 
 static const char *egl_error_name(EGLint e)
@@ -95,7 +92,7 @@ static bool egl_try_display(rs_gl_context *c, EGLDisplay dpy, char *why, size_t 
     return true;
 }
 
-static rs_result create_headless(rs_gl_context *c, rs_error *err)
+static rs_result create_headless(rs_gl_context *c, rs_gl_platform want, rs_error *err)
 {
     const char *client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     if (!client) return rs_fail(err, RS_ERR_GL, "no GLES 3 context: EGL has no client extensions (EGL 1.5 or "
@@ -104,7 +101,8 @@ static rs_result create_headless(rs_gl_context *c, rs_error *err)
         (PFNEGLGETPLATFORMDISPLAYEXTPROC)eglGetProcAddress("eglGetPlatformDisplayEXT");
     char why_sl[160] = "EGL_MESA_platform_surfaceless not offered";
     char why_dev[160] = "EGL_EXT_platform_device not offered";
-    if (get_display && has_ext(client, "EGL_MESA_platform_surfaceless")) {
+    if (want == RS_GL_DEVICE) snprintf(why_sl, sizeof why_sl, "not asked for");
+    else if (get_display && has_ext(client, "EGL_MESA_platform_surfaceless")) {
         EGLDisplay dpy = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
         if (dpy == EGL_NO_DISPLAY) snprintf(why_sl, sizeof why_sl, "no display (%s)", egl_error_name(eglGetError()));
         else if (egl_try_display(c, dpy, why_sl, sizeof why_sl)) {
@@ -113,7 +111,8 @@ static rs_result create_headless(rs_gl_context *c, rs_error *err)
         }
     }
     PFNEGLQUERYDEVICESEXTPROC query_devices = (PFNEGLQUERYDEVICESEXTPROC)eglGetProcAddress("eglQueryDevicesEXT");
-    if (get_display && query_devices && has_ext(client, "EGL_EXT_platform_device")) {
+    if (want == RS_GL_SURFACELESS) snprintf(why_dev, sizeof why_dev, "not asked for");
+    else if (get_display && query_devices && has_ext(client, "EGL_EXT_platform_device")) {
         EGLDeviceEXT devs[16];
         EGLint ndev = 0;
         if (!query_devices(16, devs, &ndev) || ndev == 0) snprintf(why_dev, sizeof why_dev, "no EGL devices");
@@ -128,43 +127,15 @@ static rs_result create_headless(rs_gl_context *c, rs_error *err)
     return rs_fail(err, RS_ERR_GL, "no GLES 3 context: surfaceless: %s; device: %s", why_sl, why_dev);
 }
 
-static char glfw_error_text[256];
-
-static void glfw_on_error(int code, const char *text)
+rs_result rs_gl_query_caps(rs_gl_caps *caps, rs_error *err)
 {
-    snprintf(glfw_error_text, sizeof glfw_error_text, "%s (0x%x)", text, code);
-}
-
-static rs_result create_window(rs_gl_context *c, const rs_gl_desc *d, rs_error *err)
-{
-    glfwSetErrorCallback(glfw_on_error);
-    glfw_error_text[0] = 0;
-    if (!glfwInit()) return rs_fail(err, RS_ERR_GL, "no window: GLFW init failed: %s", glfw_error_text);
-    glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_ES_API);
-    glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
-    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
-    glfwWindowHint(GLFW_SCALE_TO_MONITOR, GLFW_TRUE);
-    glfwWindowHint(GLFW_SAMPLES, 0);
-    GLFWmonitor *mon = d->fullscreen ? glfwGetPrimaryMonitor() : NULL;
-    int w = d->width > 0 ? d->width : 1024, h = d->height > 0 ? d->height : 768;
-    if (mon) {
-        const GLFWvidmode *mode = glfwGetVideoMode(mon);
-        if (mode) w = mode->width, h = mode->height;
-    }
-    c->window = glfwCreateWindow(w, h, d->title ? d->title : "rouge", mon, NULL);
-    if (!c->window) {
-        glfwTerminate();
-        return rs_fail(err, RS_ERR_GL, "no GLES 3 window: %s", glfw_error_text[0] ? glfw_error_text : "unknown");
-    }
-    glfwMakeContextCurrent(c->window);
-    glfwSwapInterval(1);
-    snprintf(c->caps.platform, sizeof c->caps.platform, "GLFW window");
-    return RS_OK;
-}
-
-static void query_caps(rs_gl_caps *caps)
-{
+    // Without a current context GL calls are no-ops that return NULL/0 (glvnd dispatch).
+    if (!glGetString(GL_VERSION)) return rs_fail(err, RS_ERR_GL, "no current GL context to query");
+    char platform[sizeof caps->platform];
+    memcpy(platform, caps->platform, sizeof platform);
+    memset(caps, 0, sizeof *caps);
+    memcpy(caps->platform, platform, sizeof platform);
+    if (!caps->platform[0]) snprintf(caps->platform, sizeof caps->platform, "host context");
     const char *ver = (const char *)glGetString(GL_VERSION);
     const char *ren = (const char *)glGetString(GL_RENDERER);
     snprintf(caps->version, sizeof caps->version, "%s", ver ? ver : "?");
@@ -188,6 +159,10 @@ static void query_caps(rs_gl_caps *caps)
     glGetIntegerv(GL_MAX_DRAW_BUFFERS, &caps->max_draw_buffers);
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &caps->max_texture_size);
     glGetIntegerv(GL_MAX_VERTEX_TEXTURE_IMAGE_UNITS, &caps->max_vertex_texture_units);
+    if (caps->major < 3)
+        return rs_fail(err, RS_ERR_GL, "no GLES 3 context: %s gave GLES %d.%d (%s)", caps->platform, caps->major,
+                       caps->minor, caps->version);
+    return RS_OK;
 }
 
 rs_result rs_gl_create(const rs_gl_desc *desc, rs_gl_context **out, rs_error *err)
@@ -195,17 +170,15 @@ rs_result rs_gl_create(const rs_gl_desc *desc, rs_gl_context **out, rs_error *er
     rs_gl_desc d = desc ? *desc : (rs_gl_desc){0};
     rs_gl_context *c = calloc(1, sizeof *c);
     if (!c) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
-    rs_result r = d.kind == RS_GL_WINDOW ? create_window(c, &d, err) : create_headless(c, err);
+    rs_result r = create_headless(c, d.platform, err);
     if (r != RS_OK) {
         free(c);
         return r;
     }
-    query_caps(&c->caps);
-    if (c->caps.major < 3) {
-        rs_result e = rs_fail(err, RS_ERR_GL, "no GLES 3 context: %s gave GLES %d.%d (%s)", c->caps.platform,
-                              c->caps.major, c->caps.minor, c->caps.version);
+    r = rs_gl_query_caps(&c->caps, err);
+    if (r != RS_OK) {
         rs_gl_destroy(c);
-        return e;
+        return r;
     }
     *out = c;
     return RS_OK;
@@ -214,10 +187,7 @@ rs_result rs_gl_create(const rs_gl_desc *desc, rs_gl_context **out, rs_error *er
 void rs_gl_destroy(rs_gl_context *c)
 {
     if (!c) return;
-    if (c->window) {
-        glfwDestroyWindow(c->window);
-        if (!RS_GL_KEEP_DRIVER) glfwTerminate();
-    } else if (c->dpy) {
+    if (c->dpy) {
         eglMakeCurrent(c->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
         eglDestroyContext(c->dpy, c->ctx);
         if (!RS_GL_KEEP_DRIVER) eglTerminate(c->dpy);
@@ -226,8 +196,6 @@ void rs_gl_destroy(rs_gl_context *c)
 }
 
 const rs_gl_caps *rs_gl_get_caps(const rs_gl_context *c) { return &c->caps; }
-
-GLFWwindow *rs_gl_window(const rs_gl_context *c) { return c->window; }
 
 rs_result rs_gl_check(const char *where, rs_error *err)
 {

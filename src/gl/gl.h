@@ -1,11 +1,11 @@
-// gl.h — a GLES 3.0 context, headless (EGL) or in a window (GLFW + EGL), and the capabilities that
-// every render path branches on.
+// gl.h — a headless GLES 3.0 context (EGL) and the capabilities that every render path branches on.
 //
 // Does: headless contexts through EGL_MESA_platform_surfaceless (Mesa, llvmpipe) falling back to
-// EGL_EXT_platform_device (NVIDIA and other drivers without a display); windowed contexts through GLFW
-// with GLFW_OPENGL_ES_API + GLFW_EGL_CONTEXT_API; a one-line error naming each platform tried and why it
-// failed; the caps struct (float render targets, point size range, MRT count...).
-// Does not: render anything, or own GL objects other than the context.
+// EGL_EXT_platform_device (NVIDIA and other drivers without a display); a one-line error naming each
+// platform tried and why it failed; the caps struct (float render targets, point size range, MRT
+// count...), also for a context a host application made (rs_gl_query_caps).
+// Does not: open windows (the app's window.c does, with GLFW), render anything, or own GL objects other
+// than the context.
 //
 //   rs_gl_context *gl;
 //   if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) { fprintf(stderr, "%s\n", err.msg); exit(1); }
@@ -15,17 +15,15 @@
 #ifndef RS_GL_GL_H
 #define RS_GL_GL_H
 
-#include "core.h"
+#include "core/core.h"
 
 #include <GLES3/gl3.h>
-
-typedef struct GLFWwindow GLFWwindow;
 
 typedef struct rs_gl_caps {
     int major, minor;               // GLES version of the context
     char renderer[128];             // GL_RENDERER, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)"
     char version[128];              // GL_VERSION
-    char platform[32];              // "EGL surfaceless", "EGL device", "GLFW window"
+    char platform[32];              // "EGL surfaceless", "EGL device", "GLFW window", "host context"
     bool float_rt;                  // RGBA16F colour attachments with blending (EXT_color_buffer_*_float)
     float point_size_max;           // GL_ALIASED_POINT_SIZE_RANGE[1]
     int max_draw_buffers;
@@ -33,16 +31,14 @@ typedef struct rs_gl_caps {
     int max_vertex_texture_units;
 } rs_gl_caps;
 
-typedef enum rs_gl_kind {
-    RS_GL_HEADLESS = 0,  // offscreen: render into FBOs
-    RS_GL_WINDOW,        // a GLFW window with a default framebuffer
-} rs_gl_kind;
+typedef enum rs_gl_platform {
+    RS_GL_AUTO = 0,      // surfaceless first, then EGL devices
+    RS_GL_SURFACELESS,   // EGL_MESA_platform_surfaceless only
+    RS_GL_DEVICE,        // EGL_EXT_platform_device only
+} rs_gl_platform;
 
 typedef struct rs_gl_desc {
-    rs_gl_kind kind;
-    int width, height;   // window size in screen coordinates (default 1024 x 768)
-    const char *title;   // default "rouge"
-    bool fullscreen;
+    rs_gl_platform platform;
 } rs_gl_desc;
 
 typedef struct rs_gl_context rs_gl_context;
@@ -50,8 +46,9 @@ typedef struct rs_gl_context rs_gl_context;
 rs_result rs_gl_create(const rs_gl_desc *desc, rs_gl_context **out, rs_error *err);
 void rs_gl_destroy(rs_gl_context *ctx);
 const rs_gl_caps *rs_gl_get_caps(const rs_gl_context *ctx);
-// The window (RS_GL_WINDOW) or NULL (headless).
-GLFWwindow *rs_gl_window(const rs_gl_context *ctx);
+// Fills `caps` from the current context (any platform: a host's own, a GLFW window's). caps->platform is
+// kept when set, else "host context". RS_ERR_GL when no context is current or it is not GLES 3.
+rs_result rs_gl_query_caps(rs_gl_caps *caps, rs_error *err);
 
 // Returns RS_ERR_GL naming `where` if glGetError reports an error.
 rs_result rs_gl_check(const char *where, rs_error *err);

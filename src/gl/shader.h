@@ -13,7 +13,7 @@
 #ifndef RS_GL_SHADER_H
 #define RS_GL_SHADER_H
 
-#include "core.h"
+#include "core/core.h"
 
 #include <GLES3/gl3.h>
 

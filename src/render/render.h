@@ -17,10 +17,10 @@
 #ifndef RS_RENDER_H
 #define RS_RENDER_H
 
-#include "core.h"
+#include "core/core.h"
 #include "gl/gl.h"
-#include "image.h"
-#include "makeup.h"
+#include "core/image.h"
+#include "makeup/makeup.h"
 #include "splat/splat.h"
 
 typedef enum rs_render_mode {

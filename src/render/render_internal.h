@@ -6,7 +6,7 @@
 #ifndef RS_RENDER_INTERNAL_H
 #define RS_RENDER_INTERNAL_H
 
-#include "profile.h"
+#include "render/profile.h"
 #include "render/render.h"
 
 #include <cglm/cglm.h>

@@ -4,7 +4,7 @@
 // encode float splats into records; load/validate and save .rsf files (atomic write); LOD prefixes;
 // region table with the specular parameters; the face frame (centre, forward, up) used by the camera
 // and by mirror painting.
-// Does not: touch GL (the renderer uploads `packed` as is), read PLY (tools/ply.c), or paint.
+// Does not: touch GL (the renderer uploads `packed` as is), read PLY (tools/pack/ply.c), or paint.
 //
 //   rs_error err = {0};
 //   rs_splat_cloud *c = NULL;
@@ -14,7 +14,7 @@
 #ifndef RS_SPLAT_H
 #define RS_SPLAT_H
 
-#include "../core.h"
+#include "core/core.h"
 
 #define RS_SPLAT_MAX_LODS 24
 #define RS_SPLAT_MAX_REGIONS 16

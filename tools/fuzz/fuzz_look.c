@@ -1,10 +1,10 @@
-// fuzz_look.c — libFuzzer entry point for the look-file parser and replay (src/look.c). Build and run:
-//   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc tools/fuzz/fuzz_look.c src/look.c src/makeup.c \
-//       src/cosmetics.c src/core.c src/splat/splat.c src/splat/rsf_io.c -lm -o /tmp/fuzz_look && \
+// fuzz_look.c — libFuzzer entry point for the look-file parser and replay (src/formats/look.c). Build and run:
+//   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc tools/fuzz/fuzz_look.c src/formats/look.c src/makeup/makeup.c \
+//       src/makeup/cosmetics.c src/core/core.c src/splat/splat.c src/splat/rsf_io.c -lm -o /tmp/fuzz_look && \
 //       /tmp/fuzz_look tests/fixtures/looks
 // Any input must parse or fail cleanly; a look that parses is replayed onto a small synthetic face
 // (hostile stamps must be refused or painted, never crash), saved, and must parse again.
-#include "look.h"
+#include "formats/look.h"
 
 #include <stddef.h>
 #include <stdint.h>

@@ -1,8 +1,8 @@
-// fuzz_ply.c — libFuzzer entry point for the PLY reader (tools/ply.c). Built by `make fuzz` with clang:
-//   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc -Itools tools/fuzz/fuzz_ply.c tools/ply.c src/core.c
+// fuzz_ply.c — libFuzzer entry point for the PLY reader (tools/pack/ply.c). Built by `make fuzz` with clang:
+//   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc -Itools tools/fuzz/fuzz_ply.c tools/pack/ply.c src/core/core.c
 // Seed corpus: tests/fixtures/ply/. Any input must parse or fail cleanly: no crash, leak, hang or
 // allocation beyond a small multiple of the input size.
-#include "ply.h"
+#include "pack/ply.h"
 
 #include <stddef.h>
 #include <stdint.h>

@@ -1,7 +1,7 @@
 // fuzz_rsf.c — libFuzzer entry point for the .rsf loader (src/splat/rsf_io.c). Built and run by `make fuzz`
 // (tools/fuzz.sh); by hand:
 //   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc tools/fuzz/fuzz_rsf.c src/splat/splat.c \
-//       src/splat/rsf_io.c src/core.c -lm -o /tmp/fuzz_rsf && /tmp/fuzz_rsf -dict=tools/fuzz/rsf.dict DIR
+//       src/splat/rsf_io.c src/core/core.c -lm -o /tmp/fuzz_rsf && /tmp/fuzz_rsf -dict=tools/fuzz/rsf.dict DIR
 // Seed corpus: tests/fixtures/rsf/. Any input must load or fail cleanly (no crash, leak, hang or
 // allocation beyond the input's size), failures must leave the output pointer alone and say why, and a
 // file that loads must save back to the same bytes (docs/rsf.md: "save(load(f)) gives back f").

@@ -1,9 +1,9 @@
-// fuzz_strokes.c — libFuzzer entry point for the stroke-file parser (src/strokes.c). Build and run:
-//   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc tools/fuzz/fuzz_strokes.c src/strokes.c \
-//       src/cosmetics.c src/core.c -o /tmp/fuzz_strokes && /tmp/fuzz_strokes tests/fixtures/strokes
+// fuzz_strokes.c — libFuzzer entry point for the stroke-file parser (src/formats/strokes.c). Build and run:
+//   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc tools/fuzz/fuzz_strokes.c src/formats/strokes.c \
+//       src/makeup/cosmetics.c src/core/core.c -o /tmp/fuzz_strokes && /tmp/fuzz_strokes tests/fixtures/strokes
 // Any input must parse or fail cleanly (no crash, leak, hang or large allocation), and whatever parses
 // must write back to text that parses to the same document (the writer and parser agree).
-#include "strokes.h"
+#include "formats/strokes.h"
 
 #include <stddef.h>
 #include <stdint.h>

@@ -1,0 +1,185 @@
+// cli.c — see cli.h.
+#include "cli.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef enum { OPT_FLOAT, OPT_INT, OPT_SIZE, OPT_RGB, OPT_ENUM, OPT_FLAG, OPT_PATH } opt_kind;
+
+typedef struct opt {
+    const char *name;
+    opt_kind kind;
+    const char *arg;   // shown in help
+    const char *help;
+    float lo, hi;      // range for numbers
+} opt;
+
+static const char *const mode_names[RS_MODE_COUNT] = {"full", "albedo", "diffuse", "specular", "normals",
+                                                      "regions", "shadow", "lod", "irradiance"};
+
+static const opt opts[] = {
+    {"-o", OPT_PATH, "PNG", "output image (render); written atomically", 0, 0},
+    {"--size", OPT_SIZE, "WxH", "image size in pixels (default 512x512; 16..8192)", 16, 8192},
+    {"--yaw", OPT_FLOAT, "DEG", "camera yaw around the face (0 = frontal, + = towards the subject's left)", -360, 360},
+    {"--pitch", OPT_FLOAT, "DEG", "camera pitch (+ = from above)", -89, 89},
+    {"--zoom", OPT_FLOAT, "Z", "1 = face fills the view; 2 = twice as close", 0.1f, 20},
+    {"--fov", OPT_FLOAT, "DEG", "vertical field of view (default 30)", 5, 120},
+    {"--light-yaw", OPT_FLOAT, "DEG", "key light direction, yaw", -360, 360},
+    {"--light-pitch", OPT_FLOAT, "DEG", "key light direction, pitch (+ = from above)", -90, 90},
+    {"--light-color", OPT_RGB, "R,G,B", "key light colour, linear 0..10", 0, 10},
+    {"--light-intensity", OPT_FLOAT, "X", "key light intensity (default 1)", 0, 100},
+    {"--fill-yaw", OPT_FLOAT, "DEG", "fill light yaw (enables the fill light)", -360, 360},
+    {"--fill-pitch", OPT_FLOAT, "DEG", "fill light pitch", -90, 90},
+    {"--fill-intensity", OPT_FLOAT, "X", "fill light intensity (0 = off)", 0, 100},
+    {"--mode", OPT_ENUM, "MODE", "full|albedo|diffuse|specular|normals|regions|shadow|lod|irradiance", 0, 0},
+    {"--pipeline", OPT_ENUM, "P", "reference|mobile (render default: reference; viewer default: mobile)", 0, 0},
+    {"--composite", OPT_ENUM, "C", "paper: F = A(D+S) (default) | physical: F = A D + S", 0, 0},
+    {"--exposure", OPT_FLOAT, "X", "linear exposure before sRGB encoding (default 1)", 0.01f, 100},
+    {"--background", OPT_RGB, "R,G,B", "background colour, sRGB 0..1", 0, 1},
+    {"--no-shadows", OPT_FLAG, NULL, "disable the shadow map", 0, 0},
+    {"--specular-scale", OPT_FLOAT, "X", "multiply every rho_s (1 = Weyrich's measured skin; 2 = oily skin)", 0.01f, 10},
+    {"--ambient", OPT_FLOAT, "X", "uniform sky light added to the irradiance (default 0.05)", 0, 10},
+    {"--max-splats", OPT_INT, "N", "draw at most N splats (an LOD prefix)", 1, 2e9f},
+    {"--kernels", OPT_INT, "K", "mobile pipeline: number of Gaussians (2..4, default 3)", 2, 4},
+    {"--lod-density", OPT_FLOAT, "D", "mobile pipeline: visible splats per face pixel (default 0.3)", 0.01f, 1000},
+    {"--prim", OPT_ENUM, "P", "auto|points|quads: splat primitive", 0, 0},
+    {"--strokes", OPT_PATH, "FILE", "replay a stroke file (painting) before rendering", 0, 0},
+    {"--look", OPT_PATH, "FILE", "apply a saved look (makeup layer)", 0, 0},
+    {"--save-look", OPT_PATH, "FILE", "save the look after replaying strokes", 0, 0},
+    {"--record", OPT_PATH, "FILE", "viewer: record strokes to FILE", 0, 0},
+    {"--fullscreen", OPT_FLAG, NULL, "viewer: start full-screen", 0, 0},
+    {"--events", OPT_PATH, "FILE", "viewer: replay an event script (format: see 'event scripts' below)", 0, 0},
+    {"--bench-orbit", OPT_INT, "N", "viewer: orbit for N frames, print the median frame time, exit", 1, 100000},
+};
+
+void rs_cli_print_options(FILE *f)
+{
+    for (size_t i = 0; i < RS_COUNT_OF(opts); i++) {
+        char left[64];
+        snprintf(left, sizeof left, "%s%s%s", opts[i].name, opts[i].arg ? " " : "", opts[i].arg ? opts[i].arg : "");
+        fprintf(f, "  %-24s %s\n", left, opts[i].help);
+    }
+}
+
+static bool parse_float(const char *s, float *out)
+{
+    char *end;
+    double v = strtod(s, &end);
+    if (end == s || *end || !isfinite(v)) return false;
+    *out = (float)v;
+    return true;
+}
+
+static rs_result parse_enum(const char *name, const char *v, rs_cli *c, rs_error *err)
+{
+    if (!strcmp(name, "--mode")) {
+        for (int i = 0; i < RS_MODE_COUNT; i++)
+            if (!strcmp(v, mode_names[i])) return c->view.mode = (rs_render_mode)i, RS_OK;
+    } else if (!strcmp(name, "--pipeline")) {
+        c->pipeline_set = true;
+        if (!strcmp(v, "reference")) return c->view.pipeline = RS_PIPELINE_REFERENCE, RS_OK;
+        if (!strcmp(v, "mobile")) return c->view.pipeline = RS_PIPELINE_MOBILE, RS_OK;
+    } else if (!strcmp(name, "--composite")) {
+        if (!strcmp(v, "paper")) return c->view.composite = RS_COMPOSITE_PAPER, RS_OK;
+        if (!strcmp(v, "physical")) return c->view.composite = RS_COMPOSITE_PHYSICAL, RS_OK;
+    } else if (!strcmp(name, "--prim")) {
+        if (!strcmp(v, "auto")) return c->view.prim = RS_PRIM_AUTO, RS_OK;
+        if (!strcmp(v, "points")) return c->view.prim = RS_PRIM_POINTS, RS_OK;
+        if (!strcmp(v, "quads")) return c->view.prim = RS_PRIM_QUADS, RS_OK;
+    }
+    return rs_fail(err, RS_ERR_ARG, "%s: unknown value '%s' (see --help)", name, v);
+}
+
+static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
+{
+    rs_view *w = &c->view;
+    float f = 0;
+    if (o->kind == OPT_FLOAT || o->kind == OPT_INT) {
+        if (!parse_float(v, &f)) return rs_fail(err, RS_ERR_ARG, "%s: expected a number, got '%s'", o->name, v);
+        if (f < o->lo || f > o->hi)
+            return rs_fail(err, RS_ERR_ARG, "%s: %s is out of range %g..%g", o->name, v, o->lo, o->hi);
+        if (o->kind == OPT_INT && f != floorf(f))
+            return rs_fail(err, RS_ERR_ARG, "%s: expected a whole number, got '%s'", o->name, v);
+    }
+    const char *n = o->name;
+    if (o->kind == OPT_ENUM) return parse_enum(n, v, c, err);
+    if (o->kind == OPT_SIZE) {
+        int wd, ht;
+        char x, extra;
+        if (sscanf(v, "%d%c%d%c", &wd, &x, &ht, &extra) != 3 || (x != 'x' && x != 'X') || wd < o->lo || ht < o->lo ||
+            wd > o->hi || ht > o->hi)
+            return rs_fail(err, RS_ERR_ARG, "--size: expected WxH with 16..8192 pixels each, got '%s'", v);
+        w->width = wd, w->height = ht;
+        c->size_set = true;
+        return RS_OK;
+    }
+    if (o->kind == OPT_RGB) {
+        float rgb[3];
+        char extra;
+        if (sscanf(v, "%f,%f,%f%c", &rgb[0], &rgb[1], &rgb[2], &extra) != 3)
+            return rs_fail(err, RS_ERR_ARG, "%s: expected R,G,B, got '%s'", n, v);
+        for (int i = 0; i < 3; i++)
+            if (!isfinite(rgb[i]) || rgb[i] < o->lo || rgb[i] > o->hi)
+                return rs_fail(err, RS_ERR_ARG, "%s: components must be %g..%g, got '%s'", n, o->lo, o->hi, v);
+        memcpy(!strcmp(n, "--background") ? w->background : w->key.color, rgb, sizeof rgb);
+        return RS_OK;
+    }
+    if (!strcmp(n, "-o")) c->output = v;
+    else if (!strcmp(n, "--yaw")) w->yaw_deg = f, c->view_set[0] = true;
+    else if (!strcmp(n, "--pitch")) w->pitch_deg = f, c->view_set[1] = true;
+    else if (!strcmp(n, "--zoom")) w->zoom = f, c->view_set[2] = true;
+    else if (!strcmp(n, "--fov")) w->fov_deg = f, c->view_set[3] = true;
+    else if (!strcmp(n, "--light-yaw")) w->key.yaw_deg = f;
+    else if (!strcmp(n, "--light-pitch")) w->key.pitch_deg = f;
+    else if (!strcmp(n, "--light-intensity")) w->key.intensity = f;
+    else if (!strcmp(n, "--fill-yaw")) w->fill.yaw_deg = f, w->fill.intensity = w->fill.intensity > 0 ? w->fill.intensity : 0.35f;
+    else if (!strcmp(n, "--fill-pitch")) w->fill.pitch_deg = f;
+    else if (!strcmp(n, "--fill-intensity")) w->fill.intensity = f;
+    else if (!strcmp(n, "--exposure")) w->exposure = f;
+    else if (!strcmp(n, "--no-shadows")) w->no_shadows = true;
+    else if (!strcmp(n, "--specular-scale")) w->rho_s_scale = f;
+    else if (!strcmp(n, "--ambient")) w->ambient = f;
+    else if (!strcmp(n, "--max-splats")) w->max_splats = (uint32_t)f;
+    else if (!strcmp(n, "--kernels")) w->kernel_count = (int)f;
+    else if (!strcmp(n, "--lod-density")) w->lod_density = f;
+    else if (!strcmp(n, "--strokes")) c->strokes = v;
+    else if (!strcmp(n, "--look")) c->look = v;
+    else if (!strcmp(n, "--save-look")) c->save_look = v;
+    else if (!strcmp(n, "--record")) c->record = v;
+    else if (!strcmp(n, "--fullscreen")) c->fullscreen = true;
+    else if (!strcmp(n, "--events")) c->events = v;
+    else if (!strcmp(n, "--bench-orbit")) c->bench_orbit = (int)f;
+    return RS_OK;
+}
+
+rs_result rs_cli_parse(int argc, char **argv, bool allow_output, rs_cli *out, rs_error *err)
+{
+    rs_cli c = {.view = rs_view_defaults()};
+    for (int i = 0; i < argc; i++) {
+        const char *a = argv[i];
+        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
+            c.help = true;
+            continue;
+        }
+        if (a[0] != '-' || a[1] == 0) {
+            if (c.face) return rs_fail(err, RS_ERR_ARG, "unexpected argument '%s' (one face file only)", a);
+            c.face = a;
+            continue;
+        }
+        const opt *o = NULL;
+        for (size_t k = 0; k < RS_COUNT_OF(opts); k++)
+            if (!strcmp(a, opts[k].name)) o = &opts[k];
+        if (!o) return rs_fail(err, RS_ERR_ARG, "unknown option '%s' (see --help)", a);
+        if (!strcmp(a, "-o") && !allow_output) return rs_fail(err, RS_ERR_ARG, "-o is only for 'rouge render'");
+        const char *v = NULL;
+        if (o->kind != OPT_FLAG) {
+            if (i + 1 >= argc) return rs_fail(err, RS_ERR_ARG, "%s needs a value (%s)", a, o->arg);
+            v = argv[++i];
+        }
+        rs_result r = apply(o, v, &c, err);
+        if (r) return r;
+    }
+    *out = c;
+    return RS_OK;
+}

@@ -1,0 +1,55 @@
+// main.c — the `rouge` program: `rouge render` (headless, to PNG) and `rouge view` / `rouge [FACE]`
+// (the window). The only place in rouge that prints.
+#include "app.h"
+
+#include <stdio.h>
+#include <string.h>
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "rouge — realistic skin rendering and 3D makeup on point-sampled face scans\n"
+            "\n"
+            "usage:\n"
+            "  rouge [view] [FACE.rsf] [options]        open the viewer (default face: assets/face.rsf)\n"
+            "  rouge render FACE.rsf -o OUT.png [options]  render headlessly (EGL) to a PNG\n"
+            "  rouge --help | --version\n"
+            "\n"
+            "options:\n");
+    rs_cli_print_options(f);
+    fprintf(f, "\n");
+    rs_app_print_viewer_help(f);
+    fprintf(f, "\nFace data: see assets/README.md for the bundled scan's attribution (CC BY 3.0).\n");
+}
+
+int main(int argc, char **argv)
+{
+    const char *cmd = argc > 1 ? argv[1] : "view";
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        usage(stdout);
+        return 0;
+    }
+    if (!strcmp(cmd, "--version")) {
+        printf("rouge %s\n", RS_APP_VERSION);
+        return 0;
+    }
+    bool render = !strcmp(cmd, "render");
+    int first = (render || !strcmp(cmd, "view")) ? 2 : 1;
+    rs_cli cli;
+    rs_error err = {0};
+    if (rs_cli_parse(argc - first, argv + first, render, &cli, &err) != RS_OK) {
+        fprintf(stderr, "rouge: %s\n", err.msg);
+        return 2;
+    }
+    if (cli.help) {
+        usage(stdout);
+        return 0;
+    }
+    rs_result r = render ? rs_app_render(&cli, &err) : rs_app_view(&cli, &err);
+    if (r != RS_OK) {
+        fprintf(stderr, "rouge: %s\n", err.msg);
+        return r == RS_ERR_ARG ? 2 : 1;
+    }
+    if (render) printf("rouge: wrote %s\n", cli.output);
+    return 0;
+}

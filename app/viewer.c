@@ -1,0 +1,935 @@
+// viewer.c — `rouge view`: the face in a GLFW window with a mobile-style makeup toolbar.
+//
+// One frame: poll GLFW (callbacks only queue events), let the --events script queue its events, route
+// each event to the UI or the scene (orbit / paint through src/paint/paint.c / pan / zoom / light), re-render
+// the face only when something changed (coarser LOD while the user interacts, full quality once idle),
+// draw the picture, the toolbar and overlays with app/ui.h, swap. The makeup layer, stroke filter,
+// picking and look files belong to their modules; this file maps what a person does onto them.
+#define _POSIX_C_SOURCE 200809L
+#include "app.h"
+#include "viewer_internal.h"
+#include "formats/look.h"
+#include "makeup/makeup.h"
+#include "paint/paint.h"
+#include "formats/strokes.h"
+#include "ui.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <ctype.h>
+#include <math.h>
+#include <pthread.h>
+#include <stdarg.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+// Adaptive quality: while the user interacts, pick the LOD whose frame time fits this budget; once no
+// input arrived for SETTLE_S (and SETTLE_FRAMES frames), render one frame at full quality.
+#define BUDGET_MS 40.0
+#define SETTLE_S 0.25
+#define SETTLE_FRAMES 3
+#define DEFAULT_LOOK "rouge.look"
+#define ORBIT_DEG_PER_PT 0.35f
+#define ZOOM_STEP 1.12f
+#define SIZE_MIN_REL 0.02f    // brush diameter / face height at the size slider's ends (log scale)
+#define SIZE_MAX_REL 0.40f
+#define LIGHT_DIAL_DEG 85.0f  // the light dial's rim is this far from the view axis
+#define TOAST_S 3.5
+#define DENSE_SPLATS 60000u   // below this many splats a face looks sparse: lower the resolution first
+
+// --- shortcuts: one table for --help and the help overlay (viewer_internal.h) ----------------------------
+
+// Short enough for the overlay at 800 px wide; --help adds the details below the table.
+const vw_shortcut vw_shortcuts[] = {
+    {"Left drag", "orbit; in paint mode: paint"},
+    {"Right drag, scroll", "pan, zoom (touch: two fingers)"},
+    {"L+drag, sun dial", "move the light"},
+    {"Arrows, +/-, 0", "orbit, zoom, reset the view"},
+    {"P", "paint / view mode"},
+    {"1-9, Tab", "pick a cosmetic; Tab: next"},
+    {"[ ], Shift+[ ]", "brush size, opacity"},
+    {"E, M", "eraser, mirror painting"},
+    {"Ctrl+Z, Ctrl+Y", "undo, redo"},
+    {"Delete", "clear all makeup"},
+    {"A, D, F", "albedo / diffuse / full"},
+    {"R", "mobile / reference pipeline"},
+    {"B", "before/after split"},
+    {"I", "HUD: frame time, LOD"},
+    {"S", "screenshot (rouge-NNNN.png)"},
+    {"Ctrl+S, Ctrl+O", "save / load the look"},
+    {"F11, Ctrl+Q", "full screen, quit"},
+    {"H or ?, Esc", "help; Esc closes help/split"},
+    {"Drop a .rsf file", "open another face"},
+};
+const size_t vw_shortcut_count = RS_COUNT_OF(vw_shortcuts);
+
+void rs_app_print_viewer_help(FILE *f)
+{
+    fprintf(f, "viewer controls (rouge view):\n");
+    for (size_t i = 0; i < vw_shortcut_count; i++) fprintf(f, "  %-26s %s\n", vw_shortcuts[i].keys, vw_shortcuts[i].what);
+    fprintf(f, "  Middle drag pans too; Shift+Tab picks the previous cosmetic; Ctrl+Shift+Z redoes; Esc closes\n"
+               "  the help, then the split. The toolbar does all of it by touch: swatches pick a cosmetic (and\n"
+               "  paint mode), the right rail holds the light dial, brush size and opacity; drag the split's\n"
+               "  divider to compare. The look is saved to / loaded from --look FILE (default ./%s).\n"
+               "  While orbiting or painting a coarser LOD (then a lower resolution) keeps frames near %.0f ms;\n"
+               "  the picture refines to full quality when idle.\n",
+            DEFAULT_LOOK, BUDGET_MS);
+    fprintf(f,
+            "\nevent scripts (rouge view --events FILE): one command per line, '#' comments, window coordinates\n"
+            "  move X Y | down [left|right|middle] | up [BUTTON] | click X Y | drag X0 Y0 X1 Y1 [STEPS] [BUTTON]\n"
+            "  scroll DY | key NAME (p, [, ?, ctrl+z, shift+tab, f11, esc, ...) | touch ID down|move|up X Y\n"
+            "  drop FILE | step S (script clock per pointer event, default 1/60 s) | frames N | wait S\n"
+            "  idle (until full quality) | screenshot FILE [X Y W H] (PNG of the window or a region, after\n"
+            "  idle) | wait-for FILE (until FILE exists) | quit\n");
+}
+
+// The viewer's own options: --events, --bench-orbit, and whether --size / --pipeline were given.
+typedef struct vw_options {
+    const char *events;
+    int bench_orbit;
+    bool size_set, pipeline_set;
+} vw_options;
+
+static vw_options viewer_options(const rs_cli *c)
+{
+    return (vw_options){c->events, c->bench_orbit, c->size_set, c->pipeline_set};
+}
+
+// --- small shared helpers --------------------------------------------------------------------------------
+
+// A message over the swatch sheet for a few seconds (errors longer, in red): how file results reach a
+// person without a terminal.
+void vw_toast(vw_viewer *v, bool error, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(v->toast, sizeof v->toast, fmt, ap);
+    va_end(ap);
+    v->toast_error = error;
+    v->toast_until = glfwGetTime() + (error ? 3 * TOAST_S : TOAST_S);
+}
+
+float vw_size_to_slider(float size_rel)
+{
+    float v = logf(size_rel / SIZE_MIN_REL) / logf(SIZE_MAX_REL / SIZE_MIN_REL);
+    return RS_CLAMP(v, 0.0f, 1.0f);
+}
+
+static float slider_to_size(float v) { return SIZE_MIN_REL * powf(SIZE_MAX_REL / SIZE_MIN_REL, v); }
+
+// --- picker callbacks (the renderer's ID buffer for the view on screen) -------------------------------
+
+// Pointer positions are framebuffer pixels; the picture may be rendered at a lower resolution
+// (render_scale) while the user interacts.
+bool vw_pick(void *user, float x, float y, uint32_t *idx, float hit[3])
+{
+    vw_viewer *v = user;
+    return rs_render_pick(v->ren, &v->view, x * v->render_scale, y * v->render_scale, idx, hit);
+}
+
+float vw_pixels_per_unit(void *user, const float pos[3])
+{
+    vw_viewer *v = user;
+    return rs_render_pixels_per_unit(v->ren, &v->view, pos) / v->render_scale;
+}
+
+static void view_dir_cb(void *user, const float pos[3], float dir[3])
+{
+    vw_viewer *v = user;
+    rs_render_view_dir(v->ren, &v->view, pos, dir);
+}
+
+// --- brush and view state -----------------------------------------------------------------------------
+
+static void apply_brush(vw_viewer *v)
+{
+    if (!v->paint) return;
+    rs_paint_brush b = {.cosmetic = *rs_cosmetic_get((uint32_t)v->cosmetic), .size_rel = v->size_rel,
+                        .opacity = v->opacity, .pressure = RS_MAKEUP_PRESSURE_FLOOR, .eraser = v->eraser,
+                        .mirror = v->mirror};
+    rs_paint_set_brush(v->paint, &b);
+    rs_paint_set_mode(v->paint, v->paint_mode ? RS_INPUT_PAINT : RS_INPUT_VIEW);
+}
+
+static void select_cosmetic(vw_viewer *v, int i)
+{
+    int n = (int)rs_cosmetic_count();
+    v->cosmetic = ((i % n) + n) % n;
+    const rs_cosmetic *c = rs_cosmetic_get((uint32_t)v->cosmetic);
+    // A product comes with its own brush (a liner is fine, a foundation broad), as in mobile makeup apps.
+    v->size_rel = RS_CLAMP(c->size_rel, SIZE_MIN_REL, SIZE_MAX_REL);
+    v->opacity = c->opacity;
+    v->eraser = false;
+    v->paint_mode = true;
+    apply_brush(v);
+}
+
+static void light_from_dial(vw_viewer *v)
+{
+    v->view.key.yaw_deg = v->light_dial[0] * LIGHT_DIAL_DEG;
+    v->view.key.pitch_deg = v->light_dial[1] * LIGHT_DIAL_DEG;
+    v->dirty_view = true;
+}
+
+static void dial_from_light(vw_viewer *v)
+{
+    float x = v->view.key.yaw_deg / LIGHT_DIAL_DEG, y = v->view.key.pitch_deg / LIGHT_DIAL_DEG;
+    float d = sqrtf(x * x + y * y);
+    if (d > 1) x /= d, y /= d;
+    v->light_dial[0] = x, v->light_dial[1] = y;
+}
+
+static void reset_camera(vw_viewer *v)
+{
+    const rs_cli *c = v->cli;
+    v->view.yaw_deg = c->view_set[0] ? c->view.yaw_deg : 0;
+    v->view.pitch_deg = c->view_set[1] ? c->view.pitch_deg : 0;
+    // Slightly smaller than `render`'s default so the chin clears the swatch sheet.
+    v->view.zoom = c->view_set[2] ? c->view.zoom : 0.85f;
+    v->view.pan[0] = v->view.pan[1] = 0;
+    v->dirty_view = true;
+}
+
+static void orbit(vw_viewer *v, float dx_px, float dy_px)
+{
+    float k = ORBIT_DEG_PER_PT / v->px_per_pt;
+    // Drag right turns the face to the right (the camera goes left); drag down shows it from above.
+    v->view.yaw_deg = fmodf(v->view.yaw_deg - dx_px * k, 360.0f);
+    v->view.pitch_deg = RS_CLAMP(v->view.pitch_deg + dy_px * k, -80.0f, 80.0f);
+    v->dirty_view = true;
+}
+
+static void pan(vw_viewer *v, float dx_px, float dy_px)
+{
+    v->view.pan[0] += dx_px / (float)v->fb_h;
+    v->view.pan[1] += dy_px / (float)v->fb_h;
+    v->dirty_view = true;
+}
+
+// Zoom by `factor` keeping the point under (cx, cy) fixed on screen (pinch / wheel at the cursor).
+static void zoom_at(vw_viewer *v, float factor, float cx, float cy)
+{
+    float z0 = v->view.zoom, z1 = RS_CLAMP(z0 * factor, 0.3f, 12.0f);
+    if (z1 == z0) return;
+    // The picture scales about the pan-shifted centre; move the pan so the cursor's point stays put.
+    float ox = (cx - (float)v->fb_w * 0.5f) / (float)v->fb_h, oy = (cy - (float)v->fb_h * 0.5f) / (float)v->fb_h;
+    float s = z1 / z0;
+    v->view.pan[0] = ox - (ox - v->view.pan[0]) * s;
+    v->view.pan[1] = oy - (oy - v->view.pan[1]) * s;
+    v->view.zoom = z1;
+    v->dirty_view = true;
+}
+
+static void mark_input(vw_viewer *v)
+{
+    v->last_input_s = glfwGetTime();
+    v->last_input_frame = v->frame_no;
+}
+
+static void upload(vw_viewer *v, rs_makeup_range d)
+{
+    if (d.lo >= d.hi) return;
+    rs_error err = {0};
+    const rs_makeup_gpu *rec = rs_makeup_records(v->mk);
+    if (rs_render_update_makeup(v->ren, d.lo, d.hi - d.lo, rec + d.lo, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
+    v->dirty_makeup = true;
+}
+
+// --- the face: load (in a thread, with a loading screen), open, swap -------------------------------------
+
+static void *load_main(void *arg)
+{
+    vw_loader *l = arg;
+    l->result = rs_splat_load(l->path, &l->cloud, &l->err);
+    atomic_store(&l->done, true);
+    return NULL;
+}
+
+static rs_result load_start(vw_viewer *v, const char *path, rs_error *err)
+{
+    vw_loader *l = &v->load;
+    if (l->running) return rs_fail(err, RS_ERR_ARG, "already loading %s", l->path);
+    memset(l, 0, sizeof *l);
+    snprintf(l->path, sizeof l->path, "%s", path);
+    l->t0 = glfwGetTime();
+    atomic_store(&l->done, false);
+    if (pthread_create(&l->thread, NULL, load_main, l) != 0) return rs_fail(err, RS_ERR_NOMEM, "cannot start a loader thread");
+    l->running = true;
+    return RS_OK;
+}
+
+// Joins a finished loader; false while it still runs.
+static bool load_finished(vw_viewer *v)
+{
+    vw_loader *l = &v->load;
+    if (!l->running || !atomic_load(&l->done)) return false;
+    pthread_join(l->thread, NULL);
+    l->running = false;
+    return true;
+}
+
+// The interactive quality ladder: coarser LOD prefixes first (while the face keeps a dense enough look),
+// then lower render resolutions (per-pixel passes dominate on software rasterisers), then both.
+static void build_rungs(vw_viewer *v)
+{
+    const rs_splat_header *h = &v->cloud->hdr;
+    uint32_t nl = RS_MAX(h->lod_count, 1u);
+    uint32_t lods[RS_SPLAT_MAX_LODS];
+    for (uint32_t i = 0; i < nl; i++) lods[i] = h->lod_count ? h->lods[i] : h->count;
+    uint32_t floor_n = RS_MIN(h->count, RS_MAX(DENSE_SPLATS, 1u));
+    uint32_t fi = 0;
+    while (fi + 1 < nl && lods[fi + 1] >= floor_n) fi++;
+    int n = 0;
+    for (uint32_t i = 0; i <= fi; i++) v->rungs[n++] = (vw_rung){lods[i], 1.0f};
+    v->rungs[n++] = (vw_rung){lods[fi], 0.75f};
+    v->rungs[n++] = (vw_rung){lods[fi], 0.5f};
+    for (uint32_t i = fi + 1; i < nl; i++) v->rungs[n++] = (vw_rung){lods[i], 0.5f};
+    v->rungs[n++] = (vw_rung){lods[nl - 1], 0.35f};
+    v->rung_count = n;
+    // First guess: about a quarter of the splats at full resolution; the controller adapts from there.
+    v->rung = 0;
+    while (v->rung + 1 <= (int)fi && v->rungs[v->rung].max_splats > h->count / 4) v->rung++;
+}
+
+static void face_close(vw_viewer *v)
+{
+    rs_paint_destroy(v->paint);
+    rs_makeup_destroy(v->mk);
+    rs_render_destroy(v->ren);
+    rs_splat_destroy(v->cloud);
+    v->paint = NULL, v->mk = NULL, v->ren = NULL, v->cloud = NULL;
+}
+
+// Makes `cloud` the face on screen (takes ownership). On failure the previous face stays.
+static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path, rs_error *err)
+{
+    rs_renderer *ren = NULL;
+    rs_makeup *mk = NULL;
+    rs_paint *pt = NULL;
+    rs_result r = rs_render_create(&(rs_render_desc){.cloud = cloud, .caps = rs_window_caps(v->window)}, &ren, err);
+    if (!r) r = rs_makeup_create(cloud, NULL, &mk, err);
+    if (!r) r = rs_paint_create(mk, &v->picker, &(rs_paint_desc){.input.mode = RS_INPUT_VIEW}, &pt, err);
+    if (r) {
+        rs_paint_destroy(pt);
+        rs_makeup_destroy(mk);
+        rs_render_destroy(ren);
+        rs_splat_destroy(cloud);
+        return r;
+    }
+    face_close(v);
+    v->cloud = cloud, v->ren = ren, v->mk = mk, v->paint = pt;
+    snprintf(v->face_path, sizeof v->face_path, "%s", path);
+    apply_brush(v);
+    if (v->rec) rs_paint_set_recorder(v->paint, v->rec, NULL);
+    build_rungs(v);
+    v->rendered_full = false;
+    v->dirty_view = v->dirty_makeup = true;
+    return RS_OK;
+}
+
+static void save_look(vw_viewer *v)
+{
+    rs_error err = {0};
+    if (rs_look_save(v->mk, v->look_path, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
+    else vw_toast(v, false, "Saved look to %s", v->look_path);
+}
+
+// Loads the look file; a missing file is fine when quiet_if_missing (--look names where to save too).
+static rs_result load_look(vw_viewer *v, bool quiet_if_missing, rs_error *err)
+{
+    if (quiet_if_missing && access(v->look_path, F_OK) != 0) return RS_OK;
+    rs_makeup_range d = {0, 0};
+    rs_result r = rs_look_load(v->mk, v->look_path, &d, err);
+    if (r != RS_OK) {
+        vw_toast(v, true, "%s", err->msg);
+        return r;
+    }
+    upload(v, d);
+    vw_toast(v, false, "Loaded look %s", v->look_path);
+    return RS_OK;
+}
+
+// --- actions (toolbar and keys share them) --------------------------------------------------------------
+
+static void do_undo(vw_viewer *v, bool redo)
+{
+    rs_makeup_range d = {0, 0};
+    if (redo ? rs_makeup_redo(v->mk, &d) : rs_makeup_undo(v->mk, &d)) upload(v, d);
+}
+
+static void do_clear(vw_viewer *v)
+{
+    rs_makeup_range d = {0, 0};
+    rs_error err = {0};
+    if (rs_makeup_clear(v->mk, &d, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
+    upload(v, d);
+}
+
+static void set_mode(vw_viewer *v, rs_render_mode m)
+{
+    v->view.mode = m;
+    v->dirty_view = true;
+}
+
+static void toggle_fullscreen(vw_viewer *v)
+{
+    GLFWmonitor *mon = glfwGetPrimaryMonitor();
+    if (!v->fullscreen && mon) {
+        const GLFWvidmode *mode = glfwGetVideoMode(mon);
+        glfwGetWindowPos(v->win, &v->saved_pos[0], &v->saved_pos[1]);
+        glfwGetWindowSize(v->win, &v->saved_size[0], &v->saved_size[1]);
+        if (mode) glfwSetWindowMonitor(v->win, mon, 0, 0, mode->width, mode->height, mode->refreshRate);
+        v->fullscreen = true;
+    } else if (v->fullscreen) {
+        glfwSetWindowMonitor(v->win, NULL, v->saved_pos[0], v->saved_pos[1], v->saved_size[0], v->saved_size[1], 0);
+        v->fullscreen = false;
+    }
+}
+
+static bool next_screenshot_name(vw_viewer *v, char *out, size_t n)
+{
+    for (int i = 0; i < 10000; i++) {
+        snprintf(out, n, "rouge-%04d.png", ++v->shot_counter);
+        if (access(out, F_OK) != 0) return true;
+    }
+    return false;
+}
+
+static void key_action(vw_viewer *v, int key, int mods)
+{
+    bool ctrl = mods & GLFW_MOD_CONTROL, shift = mods & GLFW_MOD_SHIFT;
+    int n = (int)rs_cosmetic_count();
+    switch (key) {
+    case GLFW_KEY_P: v->paint_mode = !v->paint_mode, apply_brush(v); break;
+    case GLFW_KEY_E: v->eraser = !v->eraser, v->paint_mode = true, apply_brush(v); break;
+    case GLFW_KEY_M: v->mirror = !v->mirror, apply_brush(v); break;
+    case GLFW_KEY_Z: if (ctrl) do_undo(v, shift); break;
+    case GLFW_KEY_Y: if (ctrl) do_undo(v, true); break;
+    case GLFW_KEY_DELETE: do_clear(v); break;
+    case GLFW_KEY_A: set_mode(v, RS_MODE_ALBEDO); break;
+    case GLFW_KEY_D: set_mode(v, RS_MODE_DIFFUSE); break;
+    case GLFW_KEY_F: set_mode(v, RS_MODE_FULL); break;
+    case GLFW_KEY_R:
+        v->view.pipeline = v->view.pipeline == RS_PIPELINE_MOBILE ? RS_PIPELINE_REFERENCE : RS_PIPELINE_MOBILE;
+        v->dirty_view = true;
+        break;
+    case GLFW_KEY_B: v->split = !v->split, v->dirty_view = true; break;
+    case GLFW_KEY_I: v->hud = !v->hud; break;
+    case GLFW_KEY_H: v->help = !v->help; break;
+    case GLFW_KEY_SLASH: if (shift) v->help = !v->help; break;
+    case GLFW_KEY_ESCAPE:
+        if (v->help) v->help = false;
+        else if (v->split) v->split = false, v->dirty_view = true;
+        break;
+    case GLFW_KEY_S:
+        if (ctrl) save_look(v);
+        else v->want_face_shot = true;
+        break;
+    case GLFW_KEY_O:
+        if (ctrl) {
+            rs_error err = {0};
+            load_look(v, false, &err);
+        }
+        break;
+    case GLFW_KEY_Q: if (ctrl) v->quit = true; break;
+    case GLFW_KEY_F11: toggle_fullscreen(v); break;
+    case GLFW_KEY_TAB: select_cosmetic(v, v->cosmetic + (shift ? -1 : 1)); break;
+    case GLFW_KEY_LEFT_BRACKET:
+    case GLFW_KEY_RIGHT_BRACKET: {
+        float d = key == GLFW_KEY_LEFT_BRACKET ? -0.08f : 0.08f;
+        if (shift) v->opacity = RS_CLAMP(v->opacity + d, 0.05f, 1.0f);
+        else v->size_rel = slider_to_size(RS_CLAMP(vw_size_to_slider(v->size_rel) + d, 0.0f, 1.0f));
+        apply_brush(v);
+        break;
+    }
+    case GLFW_KEY_LEFT: orbit(v, -40 * v->px_per_pt, 0), mark_input(v); break;
+    case GLFW_KEY_RIGHT: orbit(v, 40 * v->px_per_pt, 0), mark_input(v); break;
+    case GLFW_KEY_UP: orbit(v, 0, -40 * v->px_per_pt), mark_input(v); break;
+    case GLFW_KEY_DOWN: orbit(v, 0, 40 * v->px_per_pt), mark_input(v); break;
+    case GLFW_KEY_EQUAL:
+    case GLFW_KEY_KP_ADD: zoom_at(v, ZOOM_STEP, (float)v->fb_w * 0.5f, (float)v->fb_h * 0.5f), mark_input(v); break;
+    case GLFW_KEY_MINUS:
+    case GLFW_KEY_KP_SUBTRACT: zoom_at(v, 1 / ZOOM_STEP, (float)v->fb_w * 0.5f, (float)v->fb_h * 0.5f), mark_input(v); break;
+    case GLFW_KEY_0:
+    case GLFW_KEY_HOME: reset_camera(v); break;
+    default:
+        if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && key - GLFW_KEY_1 < n) select_cosmetic(v, key - GLFW_KEY_1);
+        break;
+    }
+}
+
+// --- input routing -------------------------------------------------------------------------------------
+
+static void feed_paint(vw_viewer *v, rs_input_type type, int id, float x, float y, double t)
+{
+    if (!v->paint) return;
+    if (type == RS_INPUT_DOWN && v->rec && v->paint_mode) {
+        // The stroke file records the camera the pixels refer to.
+        rs_strokes_view sv = {v->view.yaw_deg, v->view.pitch_deg, v->view.zoom, v->view.fov_deg,
+                              (uint32_t)v->fb_w, (uint32_t)v->fb_h};
+        rs_paint_set_recorder(v->paint, v->rec, &sv);
+    }
+    rs_input_event ev = {type, id, x, y, 1.0f, t};
+    rs_paint_result res;
+    rs_error err = {0};
+    if (rs_paint_feed(v->paint, &ev, &res, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
+    if (res.orbit_dx_px != 0 || res.orbit_dy_px != 0) orbit(v, res.orbit_dx_px, res.orbit_dy_px);
+    if (res.pan_dx_px != 0 || res.pan_dy_px != 0) pan(v, res.pan_dx_px, res.pan_dy_px);
+    if (res.zoom != 1.0f && res.zoom > 0) zoom_at(v, res.zoom, res.zoom_cx_px, res.zoom_cy_px);
+    upload(v, res.dirty);
+    if (res.stroke_end && v->rec) {
+        if (rs_strokes_save(v->rec, v->cli->record, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
+    }
+    mark_input(v);
+}
+
+static void pointer_button(vw_viewer *v, int b, bool down, double t)
+{
+    if (down) {
+        if (rs_ui_captures(v->ui, v->mx, v->my)) {
+            v->ui_owns[b] = true;
+            if (b == 0) v->ui_pressed = true;
+            return;
+        }
+        v->scene_owns[b] = true;
+        if (b == 0) {
+            v->light_drag = glfwGetKey(v->win, GLFW_KEY_L) == GLFW_PRESS;
+            if (!v->light_drag) feed_paint(v, RS_INPUT_DOWN, 0, v->mx, v->my, t);
+        }
+        return;
+    }
+    if (v->ui_owns[b]) {
+        v->ui_owns[b] = false;
+        if (b == 0) v->ui_released = true;
+        return;
+    }
+    if (!v->scene_owns[b]) return;
+    v->scene_owns[b] = false;
+    if (b == 0 && !v->light_drag) feed_paint(v, RS_INPUT_UP, 0, v->mx, v->my, t);
+    v->light_drag = false;
+}
+
+static void pointer_move(vw_viewer *v, float x, float y, double t)
+{
+    float dx = x - v->mx, dy = y - v->my;
+    v->mx = x, v->my = y;
+    v->ring_moved = true;
+    if (v->scene_owns[0]) {
+        if (v->light_drag) {
+            float k = 0.4f / v->px_per_pt;
+            v->view.key.yaw_deg = RS_CLAMP(v->view.key.yaw_deg + dx * k, -LIGHT_DIAL_DEG, LIGHT_DIAL_DEG);
+            v->view.key.pitch_deg = RS_CLAMP(v->view.key.pitch_deg - dy * k, -LIGHT_DIAL_DEG, LIGHT_DIAL_DEG);
+            dial_from_light(v);
+            v->dirty_view = true;
+            mark_input(v);
+        } else {
+            feed_paint(v, RS_INPUT_MOVE, 0, x, y, t);
+        }
+    }
+    if (v->scene_owns[1] || v->scene_owns[2]) {
+        pan(v, dx, dy);
+        mark_input(v);
+    }
+}
+
+// Routes queued events; stops after a UI tap so each tap is its own UI frame.
+static void dispatch(vw_viewer *v)
+{
+    vw_event ev;
+    while (vw_queue_pop(&v->queue, &ev)) {
+        float x = ev.x * v->px_per_pt, y = ev.y * v->px_per_pt;
+        switch (ev.type) {
+        case VW_MOVE: pointer_move(v, x, y, ev.time_s); break;
+        case VW_BUTTON:
+            if (!isnan(ev.x) && (x != v->mx || y != v->my)) pointer_move(v, x, y, ev.time_s);
+            pointer_button(v, RS_CLAMP(ev.button, 0, 2), ev.down, ev.time_s);
+            break;
+        case VW_SCROLL:
+            zoom_at(v, powf(ZOOM_STEP, ev.dy), v->mx, v->my);
+            mark_input(v);
+            break;
+        case VW_KEY: key_action(v, ev.key, ev.mods); break;
+        case VW_TOUCH: feed_paint(v, ev.touch, 100 + ev.id, x, y, ev.time_s); break;
+        case VW_DROP: {
+            rs_error err = {0};
+            if (load_start(v, ev.path, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
+            break;
+        }
+        }
+        if (v->ui_released) break;
+    }
+}
+
+// --- GLFW callbacks: queue only ---------------------------------------------------------------------------
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    vw_queue_push(&v->queue, &(vw_event){.type = VW_MOVE, .time_s = glfwGetTime(), .x = (float)x, .y = (float)y});
+}
+
+static void on_button(GLFWwindow *w, int button, int action, int mods)
+{
+    (void)mods;
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    int b = button == GLFW_MOUSE_BUTTON_LEFT ? 0 : button == GLFW_MOUSE_BUTTON_RIGHT ? 1 : button == GLFW_MOUSE_BUTTON_MIDDLE ? 2 : -1;
+    if (b < 0) return;
+    // At the pointer's last queued position: glfwGetCursorPos would answer where the pointer is now, after
+    // motion events still waiting in this batch.
+    vw_queue_push(&v->queue, &(vw_event){.type = VW_BUTTON, .time_s = glfwGetTime(), .x = NAN, .y = NAN,
+                                         .button = b, .down = action == GLFW_PRESS});
+}
+
+static void on_scroll(GLFWwindow *w, double dx, double dy)
+{
+    (void)dx;
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    vw_queue_push(&v->queue, &(vw_event){.type = VW_SCROLL, .time_s = glfwGetTime(), .dy = (float)dy});
+}
+
+static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
+{
+    (void)scancode;
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    if (action == GLFW_RELEASE || key == GLFW_KEY_UNKNOWN) return;
+    vw_queue_push(&v->queue, &(vw_event){.type = VW_KEY, .time_s = glfwGetTime(), .key = key, .mods = mods});
+}
+
+static void on_drop(GLFWwindow *w, int count, const char **paths)
+{
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    if (count < 1) return;
+    vw_event ev = {.type = VW_DROP, .time_s = glfwGetTime()};
+    snprintf(ev.path, sizeof ev.path, "%s", paths[0]);
+    vw_queue_push(&v->queue, &ev);
+}
+
+static void on_enter(GLFWwindow *w, int entered)
+{
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    v->pointer_outside = !entered;
+}
+
+static void on_refresh(GLFWwindow *w)
+{
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    v->dirty_view = true;
+}
+
+// --- frames: window size, adaptive quality, rendering ----------------------------------------------------
+
+static void update_window_size(vw_viewer *v)
+{
+    int ww, wh, fw, fh;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    glfwGetFramebufferSize(v->win, &fw, &fh);
+    if (fw < 1 || fh < 1 || ww < 1 || wh < 1) return;  // minimised
+    if (fw != v->fb_w || fh != v->fb_h) v->dirty_view = true, mark_input(v);
+    v->win_w = ww, v->win_h = wh, v->fb_w = fw, v->fb_h = fh;
+    v->px_per_pt = (float)fw / (float)ww;
+    float cx = 1, cy = 1;
+    glfwGetWindowContentScale(v->win, &cx, &cy);
+    // Content scale is pixels per point on every platform GLFW supports (macOS: the Retina factor,
+    // X11/Wayland/Windows: the DPI setting); fall back to the framebuffer ratio.
+    v->ui_scale = RS_CLAMP(RS_MAX(cx, v->px_per_pt), 1.0f, 4.0f);
+}
+
+double vw_now(void) { return glfwGetTime(); }
+
+static bool interacting(const vw_viewer *v)
+{
+    bool held = v->scene_owns[0] || v->scene_owns[1] || v->scene_owns[2] || rs_ui_busy(v->ui);
+    return held || vw_now() - v->last_input_s < SETTLE_S || v->frame_no - v->last_input_frame < SETTLE_FRAMES;
+}
+
+// Moves along the quality ladder after an interactive frame: coarser when over budget, finer when well
+// under it (the dead band between keeps it from flickering between two neighbours).
+static void adapt_quality(vw_viewer *v, double frame_ms)
+{
+    if (frame_ms > BUDGET_MS * 1.3 && v->rung + 1 < v->rung_count) v->rung += frame_ms > BUDGET_MS * 2.5 ? 2 : 1;
+    else if (frame_ms < BUDGET_MS * 0.6 && v->rung > 0) v->rung--;
+    v->rung = RS_MIN(v->rung, v->rung_count - 1);
+}
+
+// The view as rendered: the picture's resolution and LOD.
+static void apply_rung(vw_viewer *v, vw_rung q)
+{
+    v->render_scale = q.scale;
+    v->view.width = RS_MAX(16, (int)lroundf((float)v->fb_w * q.scale));
+    v->view.height = RS_MAX(16, (int)lroundf((float)v->fb_h * q.scale));
+    v->view.max_splats = q.max_splats;
+}
+
+// Renders the picture if stale; both halves in split view (the bare half only when the view changed).
+static rs_result render_scene(vw_viewer *v, rs_error *err)
+{
+    bool inter = interacting(v);
+    vw_rung want = inter ? v->rungs[v->rung] : (vw_rung){v->cli->view.max_splats, 1.0f};
+    bool quality_change = want.max_splats != v->rendered.max_splats || want.scale != v->rendered.scale ||
+                          (!inter && !v->rendered_full);
+    if (!v->dirty_view && !v->dirty_makeup && !quality_change) return RS_OK;
+    apply_rung(v, want);
+    rs_result r = RS_OK;
+    if (v->split && (v->dirty_view || quality_change || !v->before.tex)) {
+        v->view.hide_makeup = true;
+        r = rs_render_frame(v->ren, &v->view, err);
+        int tw, th;
+        GLuint tex = rs_render_output_texture(v->ren, &tw, &th);
+        if (!r) r = rs_ui_texture_copy(&v->before, tex, tw, th, err);
+        v->view.hide_makeup = false;
+    }
+    if (!r) r = rs_render_frame(v->ren, &v->view, err);
+    v->dirty_view = v->dirty_makeup = false;
+    v->rendered = want;
+    v->rendered_full = !inter;
+    v->rendered_this_frame = true;
+    return r;
+}
+
+// What a toolbar tap or drag does (the same actions as the keys).
+static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st, int sw)
+{
+    switch (t) {
+    case RS_UI_TOOL_PAINT: v->paint_mode = !v->paint_mode, apply_brush(v); break;
+    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->paint_mode = true, apply_brush(v); break;
+    case RS_UI_TOOL_MIRROR: v->mirror = !v->mirror, apply_brush(v); break;
+    case RS_UI_TOOL_UNDO: do_undo(v, false); break;
+    case RS_UI_TOOL_REDO: do_undo(v, true); break;
+    case RS_UI_TOOL_CLEAR: do_clear(v); break;
+    case RS_UI_TOOL_ALBEDO: set_mode(v, RS_MODE_ALBEDO); break;
+    case RS_UI_TOOL_DIFFUSE: set_mode(v, RS_MODE_DIFFUSE); break;
+    case RS_UI_TOOL_FULL: set_mode(v, RS_MODE_FULL); break;
+    case RS_UI_TOOL_PIPELINE: key_action(v, GLFW_KEY_R, 0); break;
+    case RS_UI_TOOL_SPLIT: v->split = !v->split, v->dirty_view = true; break;
+    case RS_UI_TOOL_HUD: v->hud = !v->hud; break;
+    case RS_UI_TOOL_SAVE: save_look(v); break;
+    case RS_UI_TOOL_LOAD: key_action(v, GLFW_KEY_O, GLFW_MOD_CONTROL); break;
+    case RS_UI_TOOL_SCREENSHOT: v->want_face_shot = true; break;
+    case RS_UI_TOOL_HELP: v->help = !v->help; break;
+    case RS_UI_TOOL_LIGHT:
+        v->light_dial[0] = st->light[0], v->light_dial[1] = st->light[1];
+        light_from_dial(v);
+        mark_input(v);
+        break;
+    case RS_UI_TOOL_SIZE: v->size_rel = slider_to_size(st->size), apply_brush(v); break;
+    case RS_UI_TOOL_OPACITY: v->opacity = RS_CLAMP(st->opacity, 0.02f, 1.0f), apply_brush(v); break;
+    case RS_UI_TOOL_SWATCH: if (sw >= 0) select_cosmetic(v, sw); break;
+    case RS_UI_TOOL_NONE:
+    case RS_UI_TOOL_COUNT: break;
+    }
+}
+
+// One frame: events, rendering, UI, swap. Returns the frame's wall time in ms.
+static double frame(vw_viewer *v, const char *script_shot, const float *script_rect, rs_error *err)
+{
+    double t0 = vw_now();
+    v->rendered_this_frame = false;
+    update_window_size(v);
+    dispatch(v);
+    if (v->ren) {
+        rs_result r = render_scene(v, err);
+        if (r) {
+            vw_toast(v, true, "%s", err->msg);
+            v->dirty_view = v->dirty_makeup = false;
+        }
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, v->fb_w, v->fb_h);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    rs_ui_begin(v->scene_ui, v->fb_w, v->fb_h, v->ui_scale, &(rs_ui_input){.x = -1, .y = -1});
+    vw_draw_picture(v, v->scene_ui);
+    rs_ui_end(v->scene_ui);
+    if (v->want_face_shot && v->ren) {
+        char name[64];
+        if (next_screenshot_name(v, name, sizeof name)) vw_write_png(v, name, NULL, false);
+        v->want_face_shot = false;
+    }
+    rs_ui_toolbar_state st;
+    int sw = -1;
+    rs_ui_tool t = vw_draw_ui(v, &st, &sw);
+    rs_ui_end(v->ui);
+    apply_tool(v, t, &st, sw);
+    if (script_shot) vw_write_png(v, script_shot, script_rect, true);
+    glfwSwapBuffers(v->win);
+    v->frame_no++;
+    double ms = (vw_now() - t0) * 1000.0;
+    if (v->rendered_this_frame) {
+        v->frame_ms_avg = v->frame_ms_avg > 0 ? v->frame_ms_avg * 0.8 + ms * 0.2 : ms;
+        if (!v->rendered_full) adapt_quality(v, ms);
+    }
+    return ms;
+}
+
+// Finishes a background load: the new face replaces the old one, or the old one stays with an error.
+static rs_result poll_loader(vw_viewer *v, bool first, rs_error *err)
+{
+    if (!load_finished(v)) return RS_OK;
+    vw_loader *l = &v->load;
+    rs_result r = l->result;
+    if (!r) r = face_open(v, l->cloud, l->path, &l->err);
+    if (r) {
+        if (first) return rs_fail(err, r, "%s", l->err.msg);
+        vw_toast(v, true, "%s", l->err.msg);
+        return RS_OK;
+    }
+    reset_camera(v);
+    if (!first) vw_toast(v, false, "Opened %s", l->path);
+    return RS_OK;
+}
+
+static bool settled(const vw_viewer *v)
+{
+    return v->ren && !v->load.running && !interacting(v) && v->rendered_full && !v->dirty_view && !v->dirty_makeup &&
+           v->queue.count == 0;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+// --bench-orbit N: N orbiting frames with adaptive quality; prints the median frame time and the LOD.
+static rs_result bench_orbit(vw_viewer *v, int n, rs_error *err)
+{
+    double *ms = rs_alloc_array((size_t)n, sizeof *ms);
+    uint32_t *splats = rs_alloc_array((size_t)n, sizeof *splats);
+    if (!ms || !splats) {
+        free(ms), free(splats);
+        return rs_fail(err, RS_ERR_NOMEM, "bench: out of memory");
+    }
+    // No vsync: we measure rendering, not the display's refresh.
+    glfwSwapInterval(0);
+    // Warm up: one full frame, and let the controller settle on its LOD over a few frames.
+    for (int i = 0; i < n + 10 && !glfwWindowShouldClose(v->win); i++) {
+        orbit(v, 6.0f * v->px_per_pt, 0);
+        mark_input(v);
+        double t = frame(v, NULL, NULL, err);
+        if (i >= 10) ms[i - 10] = t, splats[i - 10] = rs_render_get_stats(v->ren).splats_drawn;
+    }
+    qsort(ms, (size_t)n, sizeof *ms, cmp_double);
+    uint32_t lo = splats[0], hi = splats[0];
+    for (int i = 0; i < n; i++) lo = RS_MIN(lo, splats[i]), hi = RS_MAX(hi, splats[i]);
+    printf("bench-orbit: %dx%d window (%dx%d px), %s pipeline, %d frames: median %.1f ms (p90 %.1f ms), "
+           "LOD %u..%u of %u splats (budget %.0f ms), %s\n",
+           v->win_w, v->win_h, v->fb_w, v->fb_h, v->view.pipeline == RS_PIPELINE_MOBILE ? "mobile" : "reference", n,
+           ms[n / 2], ms[(n * 9) / 10], lo, hi, v->cloud->hdr.count, BUDGET_MS, rs_window_caps(v->window)->renderer);
+    free(ms);
+    free(splats);
+    return RS_OK;
+}
+
+static rs_result run(vw_viewer *v, rs_error *err)
+{
+    const rs_cli *c = v->cli;
+    rs_result r = load_start(v, c->face ? c->face : RS_APP_DEFAULT_FACE, err);
+    if (r) return r;
+    // Loading screen until the face is there.
+    while (!v->ren) {
+        if (glfwWindowShouldClose(v->win)) {
+            pthread_join(v->load.thread, NULL);
+            v->load.running = false;
+            rs_splat_destroy(v->load.cloud);
+            return RS_OK;
+        }
+        glfwPollEvents();
+        v->queue.count = 0;  // input during loading is dropped (nothing to act on)
+        if ((r = poll_loader(v, true, err))) return r;
+        if (!v->ren) {
+            frame(v, NULL, NULL, err);
+            glfwWaitEventsTimeout(0.03);
+        }
+    }
+    if (c->look && (r = load_look(v, true, err))) return r;
+    // One frame with the toolbar before any input: presses are routed by what the last frame drew.
+    frame(v, NULL, NULL, err);
+    vw_options o = viewer_options(c);
+    if (o.bench_orbit > 0) return bench_orbit(v, o.bench_orbit, err);
+
+    while (!v->quit && !glfwWindowShouldClose(v->win)) {
+        // Sleep while nothing changes: a viewer at rest costs no CPU.
+        bool busy = v->load.running || interacting(v) || v->dirty_view || v->dirty_makeup || !v->rendered_full ||
+                    (v->toast[0] && vw_now() < v->toast_until + 0.1);
+        if (busy) glfwPollEvents();
+        else glfwWaitEventsTimeout(v->have_script ? 0.01 : 0.5);
+        if ((r = poll_loader(v, false, err))) return r;
+        vw_script_step step = {0};
+        if (v->have_script) {
+            vw_script_run(&v->script, &v->queue, settled(v), vw_now(), &step);
+            if (step.quit) v->quit = true;
+            if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
+        }
+        frame(v, step.screenshot, step.rect, err);
+    }
+    return RS_OK;
+}
+
+rs_result rs_app_view(const rs_cli *cli, rs_error *err)
+{
+    vw_viewer *v = calloc(1, sizeof *v);
+    if (!v) return rs_fail(err, RS_ERR_NOMEM, "viewer: out of memory");
+    v->cli = cli;
+    rs_result r = RS_OK;
+    vw_options o = viewer_options(cli);
+    if (o.events) {
+        r = vw_script_load(o.events, &v->script, err);
+        v->have_script = r == RS_OK;
+    }
+    if (!r && cli->record) r = rs_strokes_create(&v->rec, err);
+    int w = o.size_set ? cli->view.width : 1024, h = o.size_set ? cli->view.height : 768;
+    if (!r)
+        r = rs_window_create(&(rs_window_desc){.width = w, .height = h, .title = "rouge",
+                                               .fullscreen = cli->fullscreen},
+                             &v->window, err);
+    if (!r) r = rs_ui_create(&v->ui, err);
+    if (!r) r = rs_ui_create(&v->scene_ui, err);
+    if (!r) {
+        v->win = rs_window_glfw(v->window);
+        v->fullscreen = cli->fullscreen;
+        glfwSetWindowUserPointer(v->win, v);
+        glfwSetCursorPosCallback(v->win, on_cursor);
+        glfwSetMouseButtonCallback(v->win, on_button);
+        glfwSetScrollCallback(v->win, on_scroll);
+        glfwSetKeyCallback(v->win, on_key);
+        glfwSetDropCallback(v->win, on_drop);
+        glfwSetWindowRefreshCallback(v->win, on_refresh);
+        glfwSetCursorEnterCallback(v->win, on_enter);
+        v->picker = (rs_paint_picker){.user = v, .pick = vw_pick, .pixels_per_unit = vw_pixels_per_unit, .view_dir = view_dir_cb};
+        v->view = cli->view;
+        if (!o.pipeline_set) v->view.pipeline = RS_PIPELINE_MOBILE;
+        // A soft fill from the other side: makeup is judged in even light (the key light stays movable).
+        if (v->view.fill.intensity <= 0) v->view.fill.intensity = 0.4f;
+        v->split_frac = 0.5f;
+        v->render_scale = 1;
+        v->hud = true;
+        v->last_input_s = -1e9;
+        v->last_input_frame = -1000;
+        snprintf(v->look_path, sizeof v->look_path, "%s", cli->look ? cli->look : DEFAULT_LOOK);
+        dial_from_light(v);
+        select_cosmetic(v, 0);
+        v->paint_mode = false;
+        double mx, my;
+        glfwGetCursorPos(v->win, &mx, &my);
+        update_window_size(v);
+        v->mx = (float)mx * v->px_per_pt, v->my = (float)my * v->px_per_pt;
+        r = run(v, err);
+    }
+    if (v->rec && cli->record && v->rec->count) {
+        rs_error e2 = {0};
+        rs_result r2 = rs_strokes_save(v->rec, cli->record, &e2);
+        if (!r && r2) r = r2, *err = e2;
+    }
+    if (v->load.running) pthread_join(v->load.thread, NULL), rs_splat_destroy(v->load.cloud);
+    face_close(v);
+    rs_ui_texture_free(&v->before);
+    rs_ui_destroy(v->ui);
+    rs_ui_destroy(v->scene_ui);
+    rs_window_destroy(v->window);
+    rs_strokes_destroy(v->rec);
+    vw_script_free(&v->script);
+    free(v);
+    return r;
+}

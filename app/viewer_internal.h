@@ -1,0 +1,259 @@
+// viewer_internal.h — what the viewer's files share: the event queue every input source feeds (GLFW
+// callbacks, the --events script, drag-and-drop), and the event script.
+//
+// viewer.c          the window, frame loop, input routing, actions, adaptive quality, face loading
+// viewer_draw.c     the picture, toolbar, split divider, brush ring, HUD, toasts, help, screenshots
+// viewer_events.c   the event queue and the event script (parser + player)
+#ifndef RS_APP_VIEWER_INTERNAL_H
+#define RS_APP_VIEWER_INTERNAL_H
+
+#include "cli.h"
+#include "core/core.h"
+#include "paint/input.h"
+#include "makeup/makeup.h"
+#include "paint/paint.h"
+#include "render/render.h"
+#include "formats/strokes.h"
+#include "ui.h"
+#include "window.h"
+
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdio.h>
+
+typedef struct GLFWwindow GLFWwindow;
+
+// --- events: one queue, whatever produced them ------------------------------------------------------
+
+typedef enum vw_event_type {
+    VW_MOVE = 0,   // pointer (mouse) moved to x, y
+    VW_BUTTON,     // mouse button `button` (0 left, 1 right, 2 middle) down/up at x, y
+    VW_SCROLL,     // wheel by dy (+ = away from the user = zoom in)
+    VW_KEY,        // key press: GLFW key code + GLFW modifier bits
+    VW_TOUCH,      // touch pointer `id` down/move/up at x, y
+    VW_DROP,       // a file dropped on the window
+} vw_event_type;
+
+typedef struct vw_event {
+    vw_event_type type;
+    double time_s;         // input clock (GLFW time, or the script clock)
+    float x, y;            // window coordinates (screen coordinates, not framebuffer pixels)
+    int button;
+    bool down;
+    float dy;
+    int key, mods;
+    int id;                // touch pointer id
+    rs_input_type touch;   // RS_INPUT_DOWN / MOVE / UP
+    char path[512];        // VW_DROP
+} vw_event;
+
+#define VW_QUEUE_CAP 4096
+
+typedef struct vw_queue {
+    vw_event ev[VW_QUEUE_CAP];
+    int head, count;
+    int dropped;           // events lost to a full queue (reported on the HUD)
+} vw_queue;
+
+void vw_queue_push(vw_queue *q, const vw_event *ev);
+bool vw_queue_pop(vw_queue *q, vw_event *ev);
+bool vw_queue_peek(const vw_queue *q, vw_event *ev);
+
+// --- the event script (--events FILE) ---------------------------------------------------------------
+// Format (also printed by `rouge --help`): one command per line, '#' starts a comment, coordinates are
+// window coordinates (as GLFW and xdotool see them), origin top-left.
+//   move X Y                    pointer to (X, Y)
+//   down [left|right|middle]    button press at the pointer (default left)
+//   up [left|right|middle]      button release
+//   click X Y                   move, down, up (left)
+//   drag X0 Y0 X1 Y1 [STEPS] [left|right|middle]   press, STEPS moves (default 20), release
+//   scroll DY                   mouse wheel (+ zooms in)
+//   key NAME                    a key press: a character (p, [, ?, ...) or f1..f12, esc, tab, space,
+//                               enter, left, right, up, down, delete, backspace, home; prefixes ctrl+,
+//                               shift+, alt+ (ctrl+z, shift+[)
+//   touch ID down|move|up X Y   touch pointer ID (1..9): two of them pinch and pan
+//   drop FILE                   as if FILE was dropped on the window
+//   step S                      script clock advance per pointer event (default 1/60 s)
+//   frames N                    let N frames run
+//   wait S                      keep running for S seconds
+//   idle                        run until the picture has refined to full quality
+//   screenshot FILE [X Y W H]   wait until idle, then write the window (UI included), or the region
+//                               of it, as a PNG
+//   wait-for FILE               keep running until FILE exists (sync with a test driving the window
+//                               from outside, e.g. xdotool)
+//   quit                        close the viewer (exit status 0)
+
+typedef enum vw_cmd_type {
+    VW_CMD_EVENT = 0,   // push `ev` (pointer/key/touch/drop commands expand to these)
+    VW_CMD_STEP,
+    VW_CMD_FRAMES,
+    VW_CMD_WAIT,
+    VW_CMD_IDLE,
+    VW_CMD_SCREENSHOT,
+    VW_CMD_WAIT_FOR,
+    VW_CMD_QUIT,
+} vw_cmd_type;
+
+typedef struct vw_cmd {
+    vw_cmd_type type;
+    vw_event ev;        // time_s: unset; the player stamps the script clock
+    bool advance;       // pointer events advance the script clock by one step
+    double value;       // step/wait seconds, frame count
+    int line;
+    char path[512];     // screenshot, wait-for
+    float rect[4];      // screenshot region X Y W H (window coordinates); W = 0: the whole window
+} vw_cmd;
+
+typedef struct vw_script {
+    char name[256];
+    vw_cmd *cmd;
+    int count, next;
+    double clock_s, step_s;
+    // Blocking state of the player.
+    int frames_left;
+    double wait_until;
+    bool want_idle;
+    bool want_shot;
+    bool done;
+} vw_script;
+
+#define VW_SCRIPT_MAX_BYTES (4u << 20)
+#define VW_SCRIPT_MAX_CMDS 200000
+
+// Parses a script file; errors name the file and line ("demo.events:7: unknown command 'jump'").
+rs_result vw_script_load(const char *path, vw_script *out, rs_error *err);
+void vw_script_free(vw_script *s);
+
+// What the player wants from the frame loop this frame.
+typedef struct vw_script_step {
+    bool quit;
+    const char *screenshot;  // write the window to this path at the end of this frame
+    const float *rect;       // ... this region of it (window coordinates), or all of it when rect[2] == 0
+} vw_script_step;
+
+// Runs commands until one blocks: pushes events into q. `settled` says the picture is at full quality
+// with nothing pending; now_s is the wall clock.
+void vw_script_run(vw_script *s, vw_queue *q, bool settled, double now_s, vw_script_step *out);
+
+// Key name ("ctrl+z", "f11", "?") to GLFW key code + modifiers; false when unknown.
+bool vw_key_from_name(const char *name, int *key, int *mods);
+
+// --- the viewer's state (viewer.c owns it; viewer_draw.c reads it and draws) -------------------------
+
+typedef struct vw_loader {
+    pthread_t thread;
+    bool running;
+    atomic_bool done;
+    char path[512];
+    rs_splat_cloud *cloud;
+    rs_result result;
+    rs_error err;
+    double t0;
+} vw_loader;
+
+// One step of the adaptive quality ladder: the LOD prefix drawn and the render resolution.
+typedef struct vw_rung {
+    uint32_t max_splats;
+    float scale;  // render pixels per framebuffer pixel (dynamic resolution)
+} vw_rung;
+
+typedef struct vw_viewer {
+    const rs_cli *cli;
+    rs_window *window;
+    GLFWwindow *win;
+    rs_ui *ui, *scene_ui;  // the interactive UI, and a second list for the picture (screenshots without UI)
+    vw_queue queue;
+    vw_script script;
+    bool have_script;
+
+    // The face.
+    rs_splat_cloud *cloud;
+    rs_renderer *ren;
+    rs_makeup *mk;
+    rs_paint *paint;
+    rs_paint_picker picker;
+    char face_path[512];
+    vw_loader load;
+
+    // Window (screen coordinates) and framebuffer (pixels).
+    int win_w, win_h, fb_w, fb_h;
+    float px_per_pt;  // framebuffer pixels per window coordinate
+    float ui_scale;
+    bool fullscreen;
+    int saved_pos[2], saved_size[2];
+
+    // Camera, light and what is shown.
+    rs_view view;
+    float light_dial[2];
+    bool split, hud, help, paint_mode;
+    float split_frac;
+
+    // Brush.
+    int cosmetic;  // preset index
+    float size_rel, opacity;
+    bool eraser, mirror;
+
+    // Pointer.
+    float mx, my;               // framebuffer pixels
+    bool ui_owns[3];            // a press of button b went to the UI
+    bool scene_owns[3];         // ... or to the scene
+    bool light_drag;            // L held at press: the left drag moves the light
+    bool ui_pressed, ui_released;
+    bool ring_valid;
+    float ring_px;              // brush ring radius on screen
+    bool ring_moved;
+    bool pointer_outside;       // the mouse left the window (no brush ring)
+
+    // Rendering state.
+    bool dirty_view;            // camera/light/mode changed: both halves of the split are stale
+    bool dirty_makeup;          // the made-up half is stale
+    vw_rung rungs[RS_SPLAT_MAX_LODS + 4];  // interactive quality ladder, best first
+    int rung_count, rung;       // the rung interactive frames use (adapted to the frame-time budget)
+    vw_rung rendered;              // quality of the picture on screen (max_splats 0 = full)
+    bool rendered_full;
+    float render_scale;         // render pixels per framebuffer pixel of the picture on screen
+    rs_ui_texture before;       // bare face for the split view
+    double last_input_s;
+    long long frame_no, last_input_frame;
+    double frame_ms_avg;        // frame time of rendered frames, smoothed (HUD)
+    bool rendered_this_frame;
+
+    // Files.
+    rs_strokes *rec;
+    char look_path[512];
+    int shot_counter;
+    char toast[256];
+    bool toast_error;
+    double toast_until;
+    uint8_t swatch_rgb[RS_UI_TOOLBAR_MAX_SWATCHES][3];  // the toolbar's swatches, rebuilt each frame
+    char swatch_names[RS_UI_TOOLBAR_MAX_SWATCHES][RS_COSMETIC_NAME_MAX];
+    const char *swatch_name_ptr[RS_UI_TOOLBAR_MAX_SWATCHES];
+    bool want_face_shot;        // the screenshot action: taken once the picture is drawn, before the UI
+    bool quit;
+} vw_viewer;
+
+// Shortcuts: one table for --help and the help overlay.
+typedef struct vw_shortcut {
+    const char *keys, *what;
+} vw_shortcut;
+extern const vw_shortcut vw_shortcuts[];
+extern const size_t vw_shortcut_count;
+
+// viewer.c
+double vw_now(void);
+void vw_toast(vw_viewer *v, bool error, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+float vw_size_to_slider(float size_rel);
+// The picker on the picture as shown: framebuffer pixels in, whatever resolution it was rendered at.
+bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index, float hit[3]);
+float vw_pixels_per_unit(void *viewer, const float pos[3]);
+
+// viewer_draw.c
+// The rendered picture (and the split's bare half) filling the window, into `ui`'s list.
+void vw_draw_picture(vw_viewer *v, rs_ui *ui);
+// Begins v->ui's frame and draws the toolbar and overlays; returns the tool tapped (RS_UI_TOOL_NONE if
+// none) with the toolbar state after the frame's input in *st and the swatch in *swatch.
+rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch);
+// Writes the bound framebuffer (or a region, window coordinates, when rect[2] > 0) as an RGB PNG.
+void vw_write_png(vw_viewer *v, const char *path, const float *rect, bool quiet);
+
+#endif

@@ -1,0 +1,79 @@
+// cosmetics.h — the products a person paints with: colour, material weight and finish per cosmetic.
+//
+// Does: a fixed table of presets (foundation shades 1/2/3, powder, blush, bronzer, contour, highlighter,
+// lipsticks, lip gloss, eyeshadows, eyeliner), looked up by name or listed for a UI; custom products from
+// an RGB or HSV colour and a custom finish; validation of a cosmetic's fields (for files that carry one).
+// Does not: paint (src/makeup/makeup.c applies a cosmetic to the layer) or own any state: presets are static
+// constants, customs are plain values the caller keeps.
+//
+//   const rs_cosmetic *gloss = rs_cosmetic_find("lip_gloss");
+//   rs_cosmetic mine = *rs_cosmetic_find("lipstick_satin");
+//   rs_cosmetic_hsv_to_rgb(340.0f, 0.6f, 0.8f, mine.rgb);   // custom pink, satin finish
+//   snprintf(mine.name, sizeof mine.name, "custom");
+//   for (uint32_t i = 0; i < rs_cosmetic_count(); i++) puts(rs_cosmetic_get(i)->name);
+#ifndef RS_COSMETICS_H
+#define RS_COSMETICS_H
+
+#include "core/core.h"
+
+#include <stddef.h>
+
+#define RS_COSMETIC_NAME_MAX 32  // bytes including the NUL; names are [a-z0-9_]
+
+typedef enum rs_cosmetic_kind {
+    RS_COSMETIC_CUSTOM = 0,
+    RS_COSMETIC_FOUNDATION,
+    RS_COSMETIC_POWDER,
+    RS_COSMETIC_BLUSH,
+    RS_COSMETIC_BRONZER,      // bronzer and contour
+    RS_COSMETIC_HIGHLIGHTER,
+    RS_COSMETIC_LIPSTICK,
+    RS_COSMETIC_LIP_GLOSS,
+    RS_COSMETIC_EYESHADOW,
+    RS_COSMETIC_EYELINER,
+    RS_COSMETIC_KIND_COUNT,
+} rs_cosmetic_kind;
+
+// One product. Colour weights and intensities are 0..1. `m` and `rho_s` are absolute targets in the
+// specular model's units (Beckmann roughness, Kelemen/Szirmay-Kalos scale; skin is about 0.23-0.30 and
+// 0.18-0.31): where the product lies with finish intensity 1 they replace the skin's values.
+typedef struct rs_cosmetic {
+    char name[RS_COSMETIC_NAME_MAX];  // "lip_gloss"
+    rs_cosmetic_kind kind;
+    uint8_t rgb[3];          // product colour, sRGB (converted to linear light before any mixing)
+    float material_weight;   // I_M of eq. (3): how strongly the product deposits
+    float colour_weight;     // scales the colour intensity; 0 = colourless (lip gloss, clear powder)
+    float finish_weight;     // scales the finish intensity (how much m/rho_s move towards the product's)
+    float m;                 // finish: Beckmann roughness target, 0..1
+    float rho_s;             // finish: specular scale target, 0..1
+    float size_rel;          // default brush diameter as a fraction of the face height
+    float opacity;           // default brush opacity (coverage per stroke)
+} rs_cosmetic;
+
+uint32_t rs_cosmetic_count(void);
+// Preset i (0 <= i < rs_cosmetic_count()), in UI order; NULL when out of range.
+const rs_cosmetic *rs_cosmetic_get(uint32_t i);
+// Preset by exact name ("foundation_2"); NULL when unknown.
+const rs_cosmetic *rs_cosmetic_find(const char *name);
+const char *rs_cosmetic_kind_name(rs_cosmetic_kind kind);
+
+// A custom product: colour from sRGB, finish (m, rho_s) and weights given; named "custom", default
+// brush of a medium blending brush. Values are clamped to their ranges.
+rs_cosmetic rs_cosmetic_custom(const uint8_t rgb[3], float material_weight, float m, float rho_s);
+// HSV (h in degrees, any value, wrapped; s, v in 0..1) to sRGB 8-bit: colour pickers work in HSV.
+void rs_cosmetic_hsv_to_rgb(float h_deg, float s, float v, uint8_t rgb[3]);
+
+// Checks every field is finite and in range and the name is [a-z0-9_]+ (for cosmetics read from files).
+rs_result rs_cosmetic_validate(const rs_cosmetic *c, rs_error *err);
+// Field-by-field equality (no memcmp over padding).
+bool rs_cosmetic_equal(const rs_cosmetic *a, const rs_cosmetic *b);
+
+// Text form used by stroke and look files (docs/makeup.md): a preset's name when c equals that preset,
+// else "custom name=N kind=K rgb=R,G,B weight=W colour=C finish=F m=M rho_s=S size=Z opacity=O"
+// (floats printed to round-trip exactly). Returns what snprintf returns.
+int rs_cosmetic_format(const rs_cosmetic *c, char *buf, size_t cap);
+// Parses that form (NUL-terminated, one line). "custom" needs rgb= or hsv=H,S,V plus m= and rho_s=;
+// other keys default to rs_cosmetic_custom's values. The result is validated.
+rs_result rs_cosmetic_parse(const char *text, rs_cosmetic *out, rs_error *err);
+
+#endif

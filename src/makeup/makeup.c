@@ -1,0 +1,1098 @@
+// makeup.c — the makeup layer (paper §3.1, §3.3): brush stamps compose a cosmetic onto per-splat GPU
+// records; the base skin in the cloud is never modified.
+//
+// Readings of the paper this file commits to (docs/makeup.md explains them with pictures in words):
+//
+// * Eq. (2), C = Cb (1 - I) + Cp I, in linear light. One record per splat represents the whole stack of
+//   products: applying (Cp1, I1) then (Cp2, I2) equals applying (Cp', I') with I' = 1 - (1-I1)(1-I2) and
+//   Cp' = (Cp1 I1 (1-I2) + Cp2 I2) / I' (expand the two blends to check). The finish (m, rho_s) stacks
+//   the same way with its own intensity spec_i, so a colourless gloss (colour weight 0) changes only
+//   the finish.
+//
+// * Eq. (3), I = 0.3 I_G + 0.3 I_M + 0.3 I_F. Taken literally, the I_M and I_F terms are constant over
+//   the brush, so every dab would end in a hard rim of height 0.3 (I_M + I_F) at the radius: paint, not
+//   makeup. We let the brush footprint carry every term, I = I_G (0.3 + 0.3 I_M + 0.3 I_F), which is the
+//   paper's value at the brush centre and fades smoothly to 0 at the rim. I_G is a Gaussian with sigma
+//   = radius / 2, shifted and rescaled to reach exactly 0 at the radius; I_M is the cosmetic's material
+//   weight; I_F = 1 - exp(-touches / K), K = 1 (RS_MAKEUP_TOUCH_K), with touches = the number of strokes that have reached the
+//   splat (counting strokes, not stamps, keeps the result independent of stamp spacing). The stamp's
+//   intensity is then scaled by opacity x pressure map.
+//
+// * Stroke opacity cap: within one stroke a splat takes the MAX of the intensities its stamps offer
+//   (composed over the splat's record from before the stroke), not their sum. A stroke therefore adds
+//   at most its opacity, and spacing / hand speed do not change the result: the max over stamps along
+//   a path converges to the value at the nearest point of the path. Build-up comes from repeated
+//   strokes, as with a real brush.
+//
+// * "The final colour is normalised back into the face's original colour range rather than simply
+//   overwriting it." We read this as: the pigment must not replace the skin by a flat colour and must
+//   not leave the range of colours the face already has. So (a) the product colour is clamped, per
+//   channel, into the face's original colour range (the darkest and brightest base colours of the whole
+//   cloud, per channel, ignoring the outermost 0.01 % as strays; brows, lips and highlights included,
+//   so most products stay as they are, but a white cannot glow and a black liner stays as dark as the
+//   darkest hair the scan has); and (b) it is modulated per splat by the skin's detail ratio
+//   L_base / L_local (the splat's linear luminance over the mean luminance of its neighbourhood, about
+//   two grid cells = 6 mm on a face): pores, fine lines and hairs the scan carries show through the
+//   product at the scale of the skin texture, while the product's tone replaces the skin's at larger
+//   scale. Clamping before the modulation keeps the texture even at the range's edge; the modulated
+//   pigment varies about its clamped value exactly as much as the skin varied about its local mean.
+//   Then eq. (2) mixes it in. The detail ratio rides in the record's flags byte (q/128), computed once
+//   per cloud here, so the shader needs no neighbourhood.
+#include "makeup/makeup.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define GRID_CELLS_PER_FACE 64     // cell edge = face height / 64 (about 3 mm on a face)
+#define GRID_DIM_MAX 1024u         // per axis: keys pack into 30 bits
+#define LOG_STAMPS_MAX (1u << 20)  // 1M stamps (36 MB here, ~130 MB as a look file) per session
+#define DEFAULT_UNDO_LEVELS 64u
+#define DEFAULT_UNDO_BYTES ((size_t)64 << 20)
+
+// sRGB8 <-> linear tables: a stamp composes thousands of splats, and powf per channel would be most
+// of its cost. Built once per layer (and per call of the public rs_makeup_compose).
+typedef struct colour_tables {
+    float to_lin[256];  // linear value of sRGB8 q
+    float mid[255];     // linear value at sRGB (q + 0.5) / 255: rounding thresholds back to sRGB8
+} colour_tables;
+
+typedef struct grid_cell {
+    uint32_t key, start, count;
+} grid_cell;
+
+typedef struct stroke_slot {
+    uint32_t idx;
+    rs_makeup_gpu before;
+    uint8_t touch_before;
+    float amount;  // the largest intensity this stroke offered the splat so far
+} stroke_slot;
+
+typedef struct delta {
+    uint32_t idx;
+    rs_makeup_gpu before, after;
+    uint8_t touch_before, touch_after;
+} delta;
+
+typedef struct hist_entry {
+    delta *d;
+    uint32_t n;
+} hist_entry;
+
+typedef struct log_stroke {
+    uint32_t first, count;  // stamps
+    bool clear;
+} log_stroke;
+
+struct rs_makeup {
+    const rs_splat_cloud *cloud;
+    uint32_t n;
+    rs_makeup_gpu *rec;
+    uint8_t *touch;
+    uint8_t *detail;
+    rs_makeup_uniforms uni;
+    colour_tables tables;
+    float touch_w[256];  // I_F per touch count
+    // Records changed since rs_makeup_take_dirty, per LOD band: the splat order is LOD level by level,
+    // each level spatially sorted, so a stamp's records are compact within a band but spread over all
+    // bands (one span would cover nearly the whole cloud on the bundled face, the bands ~1/10 of it).
+    uint32_t band_count;
+    uint32_t band_end[RS_SPLAT_MAX_LODS];  // ascending
+    rs_makeup_range band_dirty[RS_SPLAT_MAX_LODS];
+
+    float origin[3], cell, inv_cell;
+    uint32_t dim[3];
+    grid_cell *cells;
+    uint32_t cell_count;
+    uint32_t *hash;  // cell index + 1, 0 = empty
+    uint32_t hash_mask, hash_shift;
+    uint32_t *order;  // splat indices grouped by cell
+
+    bool in_stroke;
+    bool stroke_reserved;  // a log stroke slot exists for the open stroke
+    uint32_t stroke_first_stamp;
+    int32_t *slot_of;
+    stroke_slot *slots;
+    uint32_t slot_count, slot_cap;
+
+    hist_entry *hist;
+    uint32_t hist_count, hist_cap, hist_first;
+    size_t hist_bytes, undo_bytes;
+    uint32_t undo_levels;
+
+    log_stroke *strokes;
+    uint32_t stroke_count, stroke_cap, applied;
+    rs_makeup_applied *stamps;
+    uint32_t stamp_count, stamp_cap;
+    rs_cosmetic *cosmetics;
+    uint32_t cosmetic_count, cosmetic_cap;
+};
+
+// --- arithmetic ------------------------------------------------------------------------------------
+
+static float clamp01(float x) { return x > 0.0f ? (x < 1.0f ? x : 1.0f) : 0.0f; }
+static uint8_t q255(float x) { return (uint8_t)(clamp01(x) * 255.0f + 0.5f); }  // round half up; x >= 0
+
+static void extend(rs_makeup_range *r, uint32_t i)
+{
+    if (r->lo >= r->hi) {
+        r->lo = i, r->hi = i + 1;
+    } else {
+        r->lo = RS_MIN(r->lo, i);
+        r->hi = RS_MAX(r->hi, i + 1);
+    }
+}
+
+// Marks record i changed for rs_makeup_take_dirty.
+static void mark(rs_makeup *mk, uint32_t i)
+{
+    uint32_t b = 0;
+    while (b + 1 < mk->band_count && i >= mk->band_end[b]) b++;
+    extend(&mk->band_dirty[b], i);
+}
+
+static void mark_all(rs_makeup *mk)
+{
+    for (uint32_t b = 0; b < mk->band_count; b++)
+        mk->band_dirty[b] = (rs_makeup_range){b ? mk->band_end[b - 1] : 0, mk->band_end[b]};
+}
+
+// LOD bands [0, lods[L-1]), [lods[L-1], lods[L-2]) ... [lods[1], count); one band if the table is odd.
+static void build_bands(rs_makeup *mk)
+{
+    const rs_splat_header *h = &mk->cloud->hdr;
+    bool ok = h->lod_count >= 1 && h->lod_count <= RS_SPLAT_MAX_LODS && h->lods[0] == mk->n;
+    for (uint32_t k = 1; ok && k < h->lod_count; k++) ok = h->lods[k] > 0 && h->lods[k] < h->lods[k - 1];
+    mk->band_count = ok ? h->lod_count : 1;
+    for (uint32_t b = 0; b < mk->band_count; b++) mk->band_end[b] = ok ? h->lods[h->lod_count - 1 - b] : mk->n;
+}
+
+float rs_makeup_srgb_to_linear(float c)
+{
+    return c < 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+float rs_makeup_linear_to_srgb(float c)
+{
+    c = clamp01(c);
+    return c < 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
+}
+
+float rs_makeup_brush_radius(const rs_splat_header *hdr, float size_rel)
+{
+    // Size is the DIAMETER as a fraction of the face height: the paper's Fig. 8 sizes 0.1 / 0.2 / 0.3
+    // (top of the head to the chin, ~23 cm) then give dabs of about 2.3 / 4.6 / 7 cm: small, medium and
+    // large dabs on a cheek, as in the figure.
+    return 0.5f * size_rel * hdr->face_height;
+}
+
+static void frame_normal(const rs_splat_header *hdr, float n[3])
+{
+    const float *u = hdr->up, *f = hdr->forward;
+    n[0] = u[1] * f[2] - u[2] * f[1];
+    n[1] = u[2] * f[0] - u[0] * f[2];
+    n[2] = u[0] * f[1] - u[1] * f[0];
+    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (len > 0.0f)
+        for (int a = 0; a < 3; a++) n[a] /= len;
+}
+
+void rs_makeup_mirror_dir(const rs_splat_header *hdr, const float d[3], float out[3])
+{
+    float n[3];
+    frame_normal(hdr, n);
+    float k = 2.0f * (d[0] * n[0] + d[1] * n[1] + d[2] * n[2]);
+    for (int a = 0; a < 3; a++) out[a] = d[a] - k * n[a];
+}
+
+void rs_makeup_mirror_point(const rs_splat_header *hdr, const float p[3], float out[3])
+{
+    float n[3];
+    frame_normal(hdr, n);
+    const float *c = hdr->centre;
+    float k = 2.0f * ((p[0] - c[0]) * n[0] + (p[1] - c[1]) * n[1] + (p[2] - c[2]) * n[2]);
+    for (int a = 0; a < 3; a++) out[a] = p[a] - k * n[a];
+}
+
+float rs_makeup_pressure_scale(rs_makeup_pressure map, float pressure)
+{
+    float p = clamp01(pressure);
+    switch (map) {
+    case RS_MAKEUP_PRESSURE_LINEAR: return p;
+    case RS_MAKEUP_PRESSURE_NONE: return 1.0f;
+    default: return 0.3f + 0.7f * p;  // FLOOR: opacity 30-100 % (research/product_anchors.md §2.6)
+    }
+}
+
+// I_G from the squared distance ratio t = d^2 / r^2.
+static float falloff_t(float t)
+{
+    if (!(t < 1.0f)) return 0.0f;
+    const float k = 1.0f / (2.0f * RS_MAKEUP_SIGMA_REL * RS_MAKEUP_SIGMA_REL);
+    const float rim = expf(-k);
+    return (expf(-k * t) - rim) / (1.0f - rim);
+}
+
+float rs_makeup_falloff(float dist, float radius)
+{
+    if (!(radius > 0.0f)) return 0.0f;
+    float u = dist / radius;
+    return falloff_t(u * u);
+}
+
+float rs_makeup_touch_weight(uint32_t touches) { return 1.0f - expf(-(float)touches / RS_MAKEUP_TOUCH_K); }
+
+float rs_makeup_intensity(float i_g, float i_m, float i_f)
+{
+    // eq. (3) with the footprint on every term (see the top of this file).
+    return i_g * (0.3f + 0.3f * i_m + 0.3f * i_f);
+}
+
+static void build_tables(colour_tables *t)
+{
+    for (int q = 0; q < 256; q++) t->to_lin[q] = rs_makeup_srgb_to_linear(q / 255.0f);
+    for (int q = 0; q < 255; q++) t->mid[q] = rs_makeup_srgb_to_linear((q + 0.5f) / 255.0f);
+}
+
+// Nearest sRGB8 code of a linear value (round in the sRGB domain): binary search of the thresholds.
+static uint8_t to_srgb8(const colour_tables *t, float x)
+{
+    uint32_t lo = 0, hi = 255;
+    while (lo < hi) {
+        uint32_t m = (lo + hi) / 2;
+        if (x >= t->mid[m]) lo = m + 1;
+        else hi = m;
+    }
+    return (uint8_t)lo;
+}
+
+// A cosmetic prepared for composing: colour in linear light, weights clamped.
+typedef struct prepared {
+    float lin[3], colour_w, finish_w, m, rho_s, material_w;
+} prepared;
+
+static prepared prepare(const colour_tables *t, const rs_cosmetic *c)
+{
+    prepared p = {{t->to_lin[c->rgb[0]], t->to_lin[c->rgb[1]], t->to_lin[c->rgb[2]]},
+                  clamp01(c->colour_weight), clamp01(c->finish_weight), clamp01(c->m), clamp01(c->rho_s),
+                  clamp01(c->material_weight)};
+    return p;
+}
+
+static void compose(const colour_tables *t, rs_makeup_gpu *rec, const prepared *c, float amount, uint8_t detail)
+{
+    float a = clamp01(amount);
+    float i2 = a * c->colour_w;
+    if (i2 > 0.0f) {
+        // eq. (2) stacked: I' = 1 - (1-I1)(1-I2), Cp' = (Cp1 I1 (1-I2) + Cp2 I2) / I', linear light.
+        float i1 = rec->colour_i / 255.0f;
+        float ii = 1.0f - (1.0f - i1) * (1.0f - i2);
+        uint8_t q = q255(ii);
+        if (q > 0) {
+            for (int ch = 0; ch < 3; ch++) {
+                float cp = (t->to_lin[rec->rgb[ch]] * i1 * (1.0f - i2) + c->lin[ch] * i2) / ii;
+                rec->rgb[ch] = to_srgb8(t, cp);
+            }
+            rec->colour_i = q;
+            rec->flags = detail;
+        }
+    }
+    float s2 = a * c->finish_w;
+    if (s2 > 0.0f) {
+        float s1 = rec->spec_i / 255.0f;
+        float ss = 1.0f - (1.0f - s1) * (1.0f - s2);
+        uint8_t q = q255(ss);
+        if (q > 0) {
+            rec->m = q255(((rec->m / 255.0f) * s1 * (1.0f - s2) + c->m * s2) / ss);
+            rec->rho_s = q255(((rec->rho_s / 255.0f) * s1 * (1.0f - s2) + c->rho_s * s2) / ss);
+            rec->spec_i = q;
+        }
+    }
+}
+
+void rs_makeup_compose(rs_makeup_gpu *rec, const rs_cosmetic *c, float amount, uint8_t detail)
+{
+    colour_tables t;
+    build_tables(&t);
+    prepared p = prepare(&t, c);
+    compose(&t, rec, &p, amount, detail);
+}
+
+void rs_makeup_erase(rs_makeup_gpu *rec, float amount)
+{
+    float keep = 1.0f - clamp01(amount);
+    rec->colour_i = (uint8_t)lrintf(rec->colour_i * keep);
+    rec->spec_i = (uint8_t)lrintf(rec->spec_i * keep);
+    // Keep records canonical: a part with no intensity carries no values, so a full erase is all zero.
+    if (rec->colour_i == 0) rec->rgb[0] = rec->rgb[1] = rec->rgb[2] = rec->flags = 0;
+    if (rec->spec_i == 0) rec->m = rec->rho_s = 0;
+}
+
+void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, float albedo_lin[3], float *m,
+                         float *rho_s)
+{
+    // Same operations in the same order as rs_makeup_apply in shaders_es/makeup.glsl.
+    float ci = rec->colour_i / 255.0f;
+    if (ci > 0.0f) {
+        float detail = rec->flags / 128.0f;
+        for (int ch = 0; ch < 3; ch++) {
+            float cp = rs_makeup_srgb_to_linear(rec->rgb[ch] / 255.0f);
+            float pig = RS_MIN(RS_CLAMP(cp, u->range_lo[ch], u->range_hi[ch]) * detail, 1.0f);
+            albedo_lin[ch] = albedo_lin[ch] * (1.0f - ci) + pig * ci;  // eq. (2)
+        }
+    }
+    float si = rec->spec_i / 255.0f;
+    if (si > 0.0f) {
+        *m = *m * (1.0f - si) + (rec->m / 255.0f) * si;
+        *rho_s = *rho_s * (1.0f - si) + (rec->rho_s / 255.0f) * si;
+    }
+}
+
+// --- grid ------------------------------------------------------------------------------------------
+
+static uint32_t cell_key(uint32_t x, uint32_t y, uint32_t z) { return x | y << 10 | z << 20; }
+
+static uint32_t hash_slot(const rs_makeup *mk, uint32_t key)
+{
+    return (uint32_t)(key * 0x9E3779B1u) >> mk->hash_shift;
+}
+
+static const grid_cell *find_cell(const rs_makeup *mk, uint32_t key)
+{
+    for (uint32_t h = hash_slot(mk, key);; h = (h + 1) & mk->hash_mask) {
+        uint32_t c = mk->hash[h];
+        if (c == 0) return NULL;
+        if (mk->cells[c - 1].key == key) return &mk->cells[c - 1];
+    }
+}
+
+static uint32_t axis_cell(const rs_makeup *mk, int a, float v)
+{
+    float f = (v - mk->origin[a]) * mk->inv_cell;
+    if (!(f > 0.0f)) return 0;
+    uint32_t i = f < (float)GRID_DIM_MAX ? (uint32_t)f : GRID_DIM_MAX;
+    return i < mk->dim[a] ? i : mk->dim[a] - 1;
+}
+
+static rs_result build_grid(rs_makeup *mk, rs_error *err)
+{
+    const rs_splat_header *h = &mk->cloud->hdr;
+    float ext = 0.0f;
+    for (int a = 0; a < 3; a++) ext = RS_MAX(ext, h->bbox_max[a] - h->bbox_min[a]);
+    float cell = isfinite(h->face_height) && h->face_height > 0.0f ? h->face_height / GRID_CELLS_PER_FACE
+                                                                    : ext / GRID_CELLS_PER_FACE;
+    cell = RS_MAX(cell, ext / (float)(GRID_DIM_MAX - 1));
+    if (!(cell > 0.0f) || !isfinite(cell)) cell = 1.0f;
+    mk->cell = cell;
+    mk->inv_cell = 1.0f / cell;
+    uint64_t dim_product = 1;
+    for (int a = 0; a < 3; a++) {
+        mk->origin[a] = h->bbox_min[a];
+        float cells = floorf((h->bbox_max[a] - h->bbox_min[a]) * mk->inv_cell) + 1.0f;
+        mk->dim[a] = cells < (float)GRID_DIM_MAX ? (uint32_t)cells : GRID_DIM_MAX;
+        dim_product *= mk->dim[a];
+    }
+    uint32_t max_cells = (uint32_t)RS_MIN((uint64_t)mk->n, dim_product);
+    uint32_t cap = 16;
+    while (cap < 2u * max_cells) cap <<= 1;
+    mk->hash_mask = cap - 1;
+    mk->hash_shift = 32;
+    for (uint32_t c = cap; c > 1; c >>= 1) mk->hash_shift--;
+    mk->hash = calloc(cap, sizeof *mk->hash);
+    mk->cells = rs_alloc_array(RS_MAX(max_cells, 1u), sizeof *mk->cells);
+    mk->order = rs_alloc_array(RS_MAX(mk->n, 1u), sizeof *mk->order);
+    uint32_t *cell_of = rs_alloc_array(RS_MAX(mk->n, 1u), sizeof *cell_of);
+    if (!mk->hash || !mk->cells || !mk->order || !cell_of) {
+        free(cell_of);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: grid for %u splats: out of memory", mk->n);
+    }
+    for (uint32_t i = 0; i < mk->n; i++) {
+        const float *p = mk->cloud->pos[i];
+        uint32_t key = cell_key(axis_cell(mk, 0, p[0]), axis_cell(mk, 1, p[1]), axis_cell(mk, 2, p[2]));
+        uint32_t s = hash_slot(mk, key);
+        while (mk->hash[s] != 0 && mk->cells[mk->hash[s] - 1].key != key) s = (s + 1) & mk->hash_mask;
+        if (mk->hash[s] == 0) {
+            mk->cells[mk->cell_count] = (grid_cell){key, 0, 0};
+            mk->hash[s] = ++mk->cell_count;
+        }
+        cell_of[i] = mk->hash[s] - 1;
+        mk->cells[cell_of[i]].count++;
+    }
+    uint32_t start = 0;
+    for (uint32_t c = 0; c < mk->cell_count; c++) {
+        mk->cells[c].start = start;
+        start += mk->cells[c].count;
+        mk->cells[c].count = 0;
+    }
+    // Filling in splat order keeps each cell's splats in index (LOD/Morton) order.
+    for (uint32_t i = 0; i < mk->n; i++) {
+        grid_cell *c = &mk->cells[cell_of[i]];
+        mk->order[c->start + c->count++] = i;
+    }
+    free(cell_of);
+    return RS_OK;
+}
+
+static float luminance_of(const float lut[256], const rs_splat_packed *p)
+{
+    uint32_t w = p->w[3];
+    return 0.2126f * lut[w & 255u] + 0.7152f * lut[(w >> 8) & 255u] + 0.0722f * lut[(w >> 16) & 255u];
+}
+
+// Detail ratio L_base / L_local per splat, L_local = the cells' mean luminance interpolated
+// trilinearly between cell centres (continuous in position: no grid pattern under a flat product).
+static rs_result build_detail(rs_makeup *mk, const float lut[256], rs_error *err)
+{
+    float *cell_lum = rs_alloc_array(RS_MAX(mk->cell_count, 1u), sizeof *cell_lum);
+    if (!cell_lum) return rs_fail(err, RS_ERR_NOMEM, "makeup: detail: out of memory");
+    for (uint32_t c = 0; c < mk->cell_count; c++) {
+        const grid_cell *gc = &mk->cells[c];
+        double sum = 0.0;
+        for (uint32_t k = gc->start; k < gc->start + gc->count; k++)
+            sum += luminance_of(lut, &mk->cloud->packed[mk->order[k]]);
+        cell_lum[c] = (float)(sum / gc->count);
+    }
+    for (uint32_t i = 0; i < mk->n; i++) {
+        const float *p = mk->cloud->pos[i];
+        int base[3];
+        float f[3];
+        for (int a = 0; a < 3; a++) {
+            float u = (p[a] - mk->origin[a]) * mk->inv_cell - 0.5f;
+            float b = floorf(u);
+            base[a] = (int)RS_CLAMP(b, -1.0f, (float)GRID_DIM_MAX);
+            f[a] = RS_CLAMP(u - b, 0.0f, 1.0f);
+        }
+        float acc = 0.0f, wsum = 0.0f;
+        for (int corner = 0; corner < 8; corner++) {
+            int ix = base[0] + (corner & 1), iy = base[1] + (corner >> 1 & 1), iz = base[2] + (corner >> 2 & 1);
+            if (ix < 0 || iy < 0 || iz < 0 || (uint32_t)ix >= mk->dim[0] || (uint32_t)iy >= mk->dim[1] ||
+                (uint32_t)iz >= mk->dim[2])
+                continue;
+            const grid_cell *gc = find_cell(mk, cell_key((uint32_t)ix, (uint32_t)iy, (uint32_t)iz));
+            if (!gc) continue;
+            float w = (corner & 1 ? f[0] : 1.0f - f[0]) * (corner & 2 ? f[1] : 1.0f - f[1]) *
+                      (corner & 4 ? f[2] : 1.0f - f[2]);
+            acc += w * cell_lum[gc - mk->cells];
+            wsum += w;
+        }
+        float local = wsum > 0.0f ? acc / wsum : 0.0f;
+        float ratio = local > 1e-5f ? luminance_of(lut, &mk->cloud->packed[i]) / local : 1.0f;
+        mk->detail[i] = (uint8_t)lrintf(RS_MIN(ratio * 128.0f, 255.0f));
+    }
+    free(cell_lum);
+    return RS_OK;
+}
+
+// The face's original colour range: per channel, the 0.01th and 99.99th percentile of the base colours
+// (its extremes without stray outliers). 1st/99th was tried: on the bundled pale scan it lifted a
+// black eyeliner to a light pinkish brown.
+static void build_range(rs_makeup *mk, const float lut[256])
+{
+    uint32_t hist[3][256] = {{0}};
+    for (uint32_t i = 0; i < mk->n; i++) {
+        uint32_t w = mk->cloud->packed[i].w[3];
+        for (int ch = 0; ch < 3; ch++) hist[ch][(w >> (8 * ch)) & 255u]++;
+    }
+    uint64_t lo_rank = (uint64_t)mk->n / 10000, hi_rank = (uint64_t)mk->n - 1 - (uint64_t)mk->n / 10000;
+    for (int ch = 0; ch < 3; ch++) {
+        uint64_t seen = 0;
+        int lo = -1, hi = 255;
+        for (int v = 0; v < 256; v++) {
+            seen += hist[ch][v];
+            if (lo < 0 && seen > lo_rank) lo = v;
+            if (seen > hi_rank) {
+                hi = v;
+                break;
+            }
+        }
+        mk->uni.range_lo[ch] = mk->n ? lut[RS_MAX(lo, 0)] : 0.0f;
+        mk->uni.range_hi[ch] = mk->n ? lut[hi] : 1.0f;
+    }
+}
+
+rs_result rs_makeup_create(const rs_splat_cloud *cloud, const rs_makeup_desc *desc, rs_makeup **out,
+                           rs_error *err)
+{
+    rs_makeup *mk = calloc(1, sizeof *mk);
+    if (!mk) return rs_fail(err, RS_ERR_NOMEM, "makeup: out of memory");
+    mk->cloud = cloud;
+    mk->n = cloud->hdr.count;
+    mk->undo_levels = desc && desc->undo_levels ? desc->undo_levels : DEFAULT_UNDO_LEVELS;
+    mk->undo_bytes = desc && desc->undo_bytes ? desc->undo_bytes : DEFAULT_UNDO_BYTES;
+    build_tables(&mk->tables);
+    build_bands(mk);
+    for (int k = 0; k < 256; k++) mk->touch_w[k] = rs_makeup_touch_weight((uint32_t)k);
+    size_t n1 = RS_MAX(mk->n, 1u);
+    mk->rec = calloc(n1, sizeof *mk->rec);
+    mk->touch = calloc(n1, 1);
+    mk->detail = calloc(n1, 1);
+    mk->slot_of = rs_alloc_array(n1, sizeof *mk->slot_of);
+    if (!mk->rec || !mk->touch || !mk->detail || !mk->slot_of) {
+        rs_makeup_destroy(mk);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: layer for %u splats: out of memory", cloud->hdr.count);
+    }
+    memset(mk->slot_of, 0xff, n1 * sizeof *mk->slot_of);
+    const float *lut = mk->tables.to_lin;
+    rs_result r = build_grid(mk, err);
+    if (r == RS_OK) r = build_detail(mk, lut, err);
+    if (r != RS_OK) {
+        rs_makeup_destroy(mk);
+        return r;
+    }
+    build_range(mk, lut);
+    *out = mk;
+    return RS_OK;
+}
+
+static void free_history(rs_makeup *mk, uint32_t from)
+{
+    for (uint32_t k = from; k < mk->hist_count; k++) {
+        mk->hist_bytes -= (size_t)mk->hist[k].n * sizeof(delta);
+        free(mk->hist[k].d);
+    }
+    mk->hist_count = RS_MIN(mk->hist_count, from);
+}
+
+void rs_makeup_destroy(rs_makeup *mk)
+{
+    if (!mk) return;
+    free_history(mk, 0);
+    free(mk->hist);
+    free(mk->rec);
+    free(mk->touch);
+    free(mk->detail);
+    free(mk->cells);
+    free(mk->hash);
+    free(mk->order);
+    free(mk->slot_of);
+    free(mk->slots);
+    free(mk->strokes);
+    free(mk->stamps);
+    free(mk->cosmetics);
+    free(mk);
+}
+
+const rs_splat_cloud *rs_makeup_cloud(const rs_makeup *mk) { return mk->cloud; }
+uint32_t rs_makeup_count(const rs_makeup *mk) { return mk->n; }
+const rs_makeup_gpu *rs_makeup_records(const rs_makeup *mk) { return mk->rec; }
+const uint8_t *rs_makeup_touches(const rs_makeup *mk) { return mk->touch; }
+void rs_makeup_get_uniforms(const rs_makeup *mk, rs_makeup_uniforms *out) { *out = mk->uni; }
+
+// --- gathering -------------------------------------------------------------------------------------
+
+typedef struct cell_box {
+    uint32_t lo[3], hi[3];  // inclusive
+} cell_box;
+
+static bool cells_around(const rs_makeup *mk, const float p[3], float r, cell_box *b)
+{
+    for (int a = 0; a < 3; a++) {
+        if (p[a] + r < mk->origin[a] || p[a] - r > mk->origin[a] + mk->cell * (float)mk->dim[a]) return false;
+        b->lo[a] = axis_cell(mk, a, p[a] - r);
+        b->hi[a] = axis_cell(mk, a, p[a] + r);
+    }
+    return true;
+}
+
+// Squared distance from p to the cell's box: cells the sphere misses are skipped unread.
+static float cell_dist2(const rs_makeup *mk, const float p[3], const uint32_t c[3])
+{
+    float d2 = 0.0f;
+    for (int a = 0; a < 3; a++) {
+        float lo = mk->origin[a] + mk->cell * (float)c[a], hi = lo + mk->cell;
+        float d = p[a] < lo ? lo - p[a] : p[a] > hi ? p[a] - hi : 0.0f;
+        d2 += d * d;
+    }
+    return d2;
+}
+
+// Calls fn for every grid cell that may hold splats within r of p; returns false if fn stopped.
+typedef bool (*cell_fn)(void *user, const grid_cell *cell);
+static void for_cells(const rs_makeup *mk, const float p[3], float r, cell_fn fn, void *user, uint32_t *visited)
+{
+    cell_box b;
+    if (!cells_around(mk, p, r, &b)) return;
+    float r2 = r * r;
+    uint32_t c[3];
+    for (c[2] = b.lo[2]; c[2] <= b.hi[2]; c[2]++)
+        for (c[1] = b.lo[1]; c[1] <= b.hi[1]; c[1]++)
+            for (c[0] = b.lo[0]; c[0] <= b.hi[0]; c[0]++) {
+                if (cell_dist2(mk, p, c) > r2) continue;
+                const grid_cell *gc = find_cell(mk, cell_key(c[0], c[1], c[2]));
+                if (!gc) continue;
+                if (visited) (*visited)++;
+                if (!fn(user, gc)) return;
+            }
+}
+
+typedef struct nearest_ctx {
+    const rs_makeup *mk;
+    const float *p;
+    float best_d2;
+    uint32_t best;
+} nearest_ctx;
+
+static bool nearest_cell(void *user, const grid_cell *gc)
+{
+    nearest_ctx *x = user;
+    for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
+        uint32_t i = x->mk->order[k];
+        const float *q = x->mk->cloud->pos[i];
+        float dx = q[0] - x->p[0], dy = q[1] - x->p[1], dz = q[2] - x->p[2];
+        float d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < x->best_d2 || (d2 == x->best_d2 && i < x->best)) x->best_d2 = d2, x->best = i;
+    }
+    return true;
+}
+
+bool rs_makeup_nearest(const rs_makeup *mk, const float pos[3], float max_dist, uint32_t *idx)
+{
+    if (!(max_dist >= 0.0f) || !isfinite(pos[0]) || !isfinite(pos[1]) || !isfinite(pos[2])) return false;
+    nearest_ctx x = {mk, pos, max_dist * max_dist, UINT32_MAX};
+    // Ties at exactly max_dist count as inside.
+    x.best_d2 = nextafterf(x.best_d2, INFINITY);
+    for_cells(mk, pos, max_dist, nearest_cell, &x, NULL);
+    if (x.best == UINT32_MAX) return false;
+    *idx = x.best;
+    return true;
+}
+
+static uint32_t sum_cell_counts(const rs_makeup *mk, const float p[3], float r)
+{
+    cell_box b;
+    if (!cells_around(mk, p, r, &b)) return 0;
+    uint64_t sum = 0;
+    uint32_t c[3];
+    for (c[2] = b.lo[2]; c[2] <= b.hi[2]; c[2]++)
+        for (c[1] = b.lo[1]; c[1] <= b.hi[1]; c[1]++)
+            for (c[0] = b.lo[0]; c[0] <= b.hi[0]; c[0]++) {
+                if (cell_dist2(mk, p, c) > r * r) continue;
+                const grid_cell *gc = find_cell(mk, cell_key(c[0], c[1], c[2]));
+                if (gc) sum += gc->count;
+            }
+    return (uint32_t)RS_MIN(sum, (uint64_t)mk->n);
+}
+
+// --- stamping --------------------------------------------------------------------------------------
+
+typedef struct stamp_ctx {
+    rs_makeup *mk;
+    const float *p, *view;
+    bool facing;
+    float facing_min;  // RS_MAKEUP_FACING_MIN * |view|: no normalising, so replays see the same bits
+    float r2, inv_r2, amount;
+    const prepared *cos;  // NULL = eraser
+    rs_makeup_stamp_info *info;
+} stamp_ctx;
+
+
+static void stamp_splat(stamp_ctx *x, uint32_t i)
+{
+    rs_makeup *mk = x->mk;
+    const float *q = mk->cloud->pos[i];
+    float dx = q[0] - x->p[0], dy = q[1] - x->p[1], dz = q[2] - x->p[2];
+    float d2 = dx * dx + dy * dy + dz * dz;
+    if (!(d2 < x->r2)) return;
+    if (x->facing) {
+        const float *nrm = mk->cloud->normal[i];
+        if (!(nrm[0] * x->view[0] + nrm[1] * x->view[1] + nrm[2] * x->view[2] > x->facing_min)) return;
+    }
+    float ig = falloff_t(d2 * x->inv_r2);
+    if (!(ig > 0.0f)) return;
+    x->info->touched++;
+    int32_t s = mk->slot_of[i];
+    if (s < 0) {
+        // Capacity was reserved before the gather (rs_makeup_stamp), so this cannot fail.
+        s = (int32_t)mk->slot_count++;
+        mk->slots[s] = (stroke_slot){i, mk->rec[i], mk->touch[i], 0.0f};
+        mk->slot_of[i] = s;
+        if (x->cos && mk->touch[i] < 255) mk->touch[i]++;
+    }
+    stroke_slot *sl = &mk->slots[s];
+    float a = x->cos ? x->amount * rs_makeup_intensity(ig, x->cos->material_w, mk->touch_w[mk->touch[i]])
+                     : x->amount * RS_MIN(1.0f, 2.0f * ig);  // eraser: flat top, full erase in the inner half
+    if (!(a > sl->amount)) return;  // the stroke opacity cap: max over the stroke's stamps
+    sl->amount = a;
+    rs_makeup_gpu r = sl->before;
+    if (x->cos) {
+        compose(&mk->tables, &r, x->cos, a, mk->detail[i]);
+    } else {
+        rs_makeup_erase(&r, a);
+        if (!(r.colour_i | r.spec_i)) mk->touch[i] = 0;  // fully erased: back to bare skin, I_F too
+    }
+    if (memcmp(&r, &mk->rec[i], sizeof r) != 0) {
+        mk->rec[i] = r;
+        extend(&x->info->dirty, i);
+        mark(mk, i);
+    }
+}
+
+static bool stamp_cell(void *user, const grid_cell *gc)
+{
+    stamp_ctx *x = user;
+    x->info->examined += gc->count;
+    for (uint32_t k = gc->start; k < gc->start + gc->count; k++) stamp_splat(x, x->mk->order[k]);
+    return true;
+}
+
+static bool grow(void **p, uint32_t *cap, uint32_t need, size_t elem)
+{
+    if (need <= *cap) return true;
+    uint64_t c = RS_MAX((uint64_t)*cap * 2, 64u);
+    while (c < need) c *= 2;
+    c = RS_MIN(c, (uint64_t)UINT32_MAX);
+    size_t bytes;
+    if (!rs_size_mul((size_t)c, elem, &bytes)) return false;
+    void *q = realloc(*p, bytes);
+    if (!q) return false;
+    *p = q;
+    *cap = (uint32_t)c;
+    return true;
+}
+
+static int log_cosmetic(rs_makeup *mk, const rs_cosmetic *c)
+{
+    for (uint32_t i = 0; i < mk->cosmetic_count; i++)
+        if (rs_cosmetic_equal(&mk->cosmetics[i], c)) return (int)i;
+    if (mk->cosmetic_count >= UINT16_MAX) return -1;
+    if (!grow((void **)&mk->cosmetics, &mk->cosmetic_cap, mk->cosmetic_count + 1, sizeof *mk->cosmetics))
+        return -1;
+    mk->cosmetics[mk->cosmetic_count] = *c;
+    return (int)mk->cosmetic_count++;
+}
+
+static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
+static void apply_stamp(rs_makeup *mk, const rs_makeup_applied *s, const rs_cosmetic *cosmetic,
+                        rs_makeup_stamp_info *info)
+{
+    prepared prep;
+    const prepared *cos = NULL;
+    if (cosmetic) {
+        prep = prepare(&mk->tables, cosmetic);
+        cos = &prep;
+    }
+    const float *v = s->view_dir;
+    float vlen = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    stamp_ctx x = {mk, s->pos, v, vlen > 0.0f, RS_MAKEUP_FACING_MIN * vlen, s->radius * s->radius,
+                   1.0f / (s->radius * s->radius), s->amount, cos, info};
+    for_cells(mk, s->pos, s->radius, stamp_cell, &x, &info->cells);
+    mk->stamps[mk->stamp_count++] = *s;
+}
+
+void rs_makeup_begin_stroke(rs_makeup *mk)
+{
+    if (mk->in_stroke) rs_makeup_end_stroke(mk, NULL);
+    mk->in_stroke = true;
+    mk->stroke_reserved = false;
+    mk->stroke_first_stamp = mk->stamp_count;
+    mk->slot_count = 0;
+}
+
+bool rs_makeup_in_stroke(const rs_makeup *mk) { return mk->in_stroke; }
+
+rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeup_stamp_info *info,
+                          rs_error *err)
+{
+    rs_makeup_stamp_info local;
+    if (!info) info = &local;
+    memset(info, 0, sizeof *info);
+    if (!finite3(d->pos) || !finite3(d->view_dir))
+        return rs_fail(err, RS_ERR_ARG, "makeup stamp: position or view direction not finite");
+    // A brush wider than the face is a mistake (and would make a stamp cost the whole grid).
+    if (!isfinite(d->radius) || !(d->radius > 0.0f) || !(d->radius <= mk->cloud->hdr.face_height))
+        return rs_fail(err, RS_ERR_ARG, "makeup stamp: radius %g, must be in (0, face height %g]", d->radius,
+                       mk->cloud->hdr.face_height);
+    if (!isfinite(d->opacity) || !isfinite(d->pressure) || (unsigned)d->pressure_map >= RS_MAKEUP_PRESSURE_COUNT)
+        return rs_fail(err, RS_ERR_ARG, "makeup stamp: opacity, pressure or pressure map invalid");
+    if (!d->eraser) {
+        if (!d->cosmetic) return rs_fail(err, RS_ERR_ARG, "makeup stamp: no cosmetic");
+        rs_error cerr = {0};
+        if (rs_cosmetic_validate(d->cosmetic, &cerr) != RS_OK)
+            return rs_fail(err, RS_ERR_ARG, "makeup stamp: %s", cerr.msg);
+    }
+    bool implicit = !mk->in_stroke;
+    if (implicit) rs_makeup_begin_stroke(mk);
+
+    // Reserve everything first, so a failure leaves the layer untouched.
+    uint32_t mirror_idx = UINT32_MAX;
+    float mpos[3];
+    if (d->mirror) {
+        rs_makeup_mirror_point(&mk->cloud->hdr, d->pos, mpos);
+        // The mirror image of a surface point lies near the other side's surface; snap to the nearest
+        // splat within one brush radius (none: the face is not symmetric there, skip the mirror).
+        if (!rs_makeup_nearest(mk, mpos, d->radius, &mirror_idx)) mirror_idx = UINT32_MAX;
+    }
+    uint32_t need = sum_cell_counts(mk, d->pos, d->radius);
+    if (mirror_idx != UINT32_MAX) need += sum_cell_counts(mk, mk->cloud->pos[mirror_idx], d->radius);
+    int cos_index = d->eraser ? 0 : log_cosmetic(mk, d->cosmetic);
+    bool ok = cos_index >= 0 && mk->stamp_count + 2 <= LOG_STAMPS_MAX &&
+              grow((void **)&mk->stamps, &mk->stamp_cap, mk->stamp_count + 2, sizeof *mk->stamps) &&
+              grow((void **)&mk->slots, &mk->slot_cap, (uint32_t)RS_MIN((uint64_t)mk->slot_count + need,
+                                                                       (uint64_t)mk->n + 1), sizeof *mk->slots) &&
+              (mk->stroke_reserved ||
+               grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes));
+    if (!ok) {
+        if (implicit) mk->in_stroke = false;
+        return rs_fail(err, mk->stamp_count + 2 > LOG_STAMPS_MAX ? RS_ERR_LIMIT : RS_ERR_NOMEM,
+                       "makeup stamp: %s", mk->stamp_count + 2 > LOG_STAMPS_MAX
+                                               ? "stamp log full (save the look and clear)"
+                                               : "out of memory");
+    }
+    mk->stroke_reserved = true;
+
+    const rs_cosmetic *cos = d->eraser ? NULL : &mk->cosmetics[cos_index];
+    rs_makeup_applied s = {{d->pos[0], d->pos[1], d->pos[2]},
+                           {d->view_dir[0], d->view_dir[1], d->view_dir[2]},
+                           d->radius,
+                           clamp01(d->opacity) * rs_makeup_pressure_scale(d->pressure_map, d->pressure),
+                           (uint16_t)cos_index,
+                           d->eraser,
+                           mk->stamp_count == mk->stroke_first_stamp};
+    apply_stamp(mk, &s, cos, info);
+    if (mirror_idx != UINT32_MAX) {
+        memcpy(s.pos, mk->cloud->pos[mirror_idx], sizeof s.pos);
+        rs_makeup_mirror_dir(&mk->cloud->hdr, d->view_dir, s.view_dir);
+        s.stroke_start = 0;
+        apply_stamp(mk, &s, cos, info);
+        info->mirrored = true;
+    }
+    if (implicit) return rs_makeup_end_stroke(mk, err);
+    return RS_OK;
+}
+
+// --- strokes, history, log ---------------------------------------------------------------------------
+
+static uint32_t applied_stamp_end(const rs_makeup *mk)
+{
+    if (mk->applied == 0) return 0;
+    const log_stroke *s = &mk->strokes[mk->applied - 1];
+    return s->first + s->count;
+}
+
+// A new stroke after undo discards the undone strokes (their log stamps and history).
+static void truncate_redo(rs_makeup *mk)
+{
+    free_history(mk, mk->applied - mk->hist_first);
+    mk->stroke_count = mk->applied;
+}
+
+static void forget_all_history(rs_makeup *mk)
+{
+    free_history(mk, 0);
+    mk->hist_first = mk->stroke_count;
+}
+
+// Pushes a finished stroke's deltas (taking ownership) and evicts the oldest beyond the budget.
+static rs_result push_history(rs_makeup *mk, delta *d, uint32_t n, rs_error *err)
+{
+    if (!grow((void **)&mk->hist, &mk->hist_cap, mk->hist_count + 1, sizeof *mk->hist)) {
+        free(d);
+        forget_all_history(mk);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: undo history: out of memory (history dropped)");
+    }
+    mk->hist[mk->hist_count++] = (hist_entry){d, n};
+    mk->hist_bytes += (size_t)n * sizeof *d;
+    uint32_t drop = 0;
+    size_t bytes = mk->hist_bytes;
+    while (mk->hist_count - drop > 1 && (mk->hist_count - drop > mk->undo_levels || bytes > mk->undo_bytes)) {
+        bytes -= (size_t)mk->hist[drop].n * sizeof(delta);
+        free(mk->hist[drop].d);
+        drop++;
+    }
+    if (drop) {
+        memmove(mk->hist, mk->hist + drop, (mk->hist_count - drop) * sizeof *mk->hist);
+        mk->hist_count -= drop;
+        mk->hist_first += drop;
+        mk->hist_bytes = bytes;
+    }
+    return RS_OK;
+}
+
+// Appends a stroke to the log (capacity reserved by the caller) after discarding undone strokes.
+static void log_push_stroke(rs_makeup *mk, uint32_t first, uint32_t count, bool clear)
+{
+    truncate_redo(mk);
+    uint32_t dst = applied_stamp_end(mk);
+    if (count && dst != first) memmove(mk->stamps + dst, mk->stamps + first, count * sizeof *mk->stamps);
+    mk->stamp_count = dst + count;
+    mk->strokes[mk->stroke_count++] = (log_stroke){dst, count, clear};
+    mk->applied = mk->stroke_count;
+}
+
+rs_result rs_makeup_end_stroke(rs_makeup *mk, rs_error *err)
+{
+    if (!mk->in_stroke) return RS_OK;
+    mk->in_stroke = false;
+    uint32_t changed = 0;
+    for (uint32_t k = 0; k < mk->slot_count; k++) {
+        const stroke_slot *s = &mk->slots[k];
+        mk->slot_of[s->idx] = -1;
+        if (memcmp(&s->before, &mk->rec[s->idx], sizeof s->before) != 0 || s->touch_before != mk->touch[s->idx])
+            changed++;
+    }
+    if (changed == 0) {
+        // Nothing happened: the stroke leaves no trace in the log or the history.
+        mk->stamp_count = mk->stroke_first_stamp;
+        mk->slot_count = 0;
+        return RS_OK;
+    }
+    log_push_stroke(mk, mk->stroke_first_stamp, mk->stamp_count - mk->stroke_first_stamp, false);
+    delta *d = rs_alloc_array(changed, sizeof *d);
+    if (!d) {
+        mk->slot_count = 0;
+        forget_all_history(mk);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: undo for a stroke of %u splats: out of memory", changed);
+    }
+    uint32_t j = 0;
+    for (uint32_t k = 0; k < mk->slot_count; k++) {
+        const stroke_slot *s = &mk->slots[k];
+        if (memcmp(&s->before, &mk->rec[s->idx], sizeof s->before) == 0 && s->touch_before == mk->touch[s->idx])
+            continue;
+        d[j++] = (delta){s->idx, s->before, mk->rec[s->idx], s->touch_before, mk->touch[s->idx]};
+    }
+    mk->slot_count = 0;
+    return push_history(mk, d, changed, err);
+}
+
+void rs_makeup_cancel_stroke(rs_makeup *mk, rs_makeup_range *dirty)
+{
+    rs_makeup_range r = {0, 0};
+    if (mk->in_stroke) {
+        for (uint32_t k = 0; k < mk->slot_count; k++) {
+            const stroke_slot *s = &mk->slots[k];
+            if (memcmp(&s->before, &mk->rec[s->idx], sizeof s->before) != 0) {
+                extend(&r, s->idx);
+                mark(mk, s->idx);
+            }
+            mk->rec[s->idx] = s->before;
+            mk->touch[s->idx] = s->touch_before;
+            mk->slot_of[s->idx] = -1;
+        }
+        mk->slot_count = 0;
+        mk->stamp_count = mk->stroke_first_stamp;
+        mk->in_stroke = false;
+    }
+    if (dirty) *dirty = r;
+}
+
+static void apply_deltas(rs_makeup *mk, const hist_entry *h, bool forward, rs_makeup_range *dirty)
+{
+    rs_makeup_range r = {0, 0};
+    for (uint32_t k = 0; k < h->n; k++) {
+        const delta *d = &h->d[k];
+        mk->rec[d->idx] = forward ? d->after : d->before;
+        mk->touch[d->idx] = forward ? d->touch_after : d->touch_before;
+        extend(&r, d->idx);
+        mark(mk, d->idx);
+    }
+    if (dirty) *dirty = r;
+}
+
+bool rs_makeup_can_undo(const rs_makeup *mk) { return mk->applied > mk->hist_first || mk->in_stroke; }
+bool rs_makeup_can_redo(const rs_makeup *mk) { return !mk->in_stroke && mk->applied < mk->stroke_count; }
+
+bool rs_makeup_undo(rs_makeup *mk, rs_makeup_range *dirty)
+{
+    if (dirty) *dirty = (rs_makeup_range){0, 0};
+    if (mk->in_stroke) rs_makeup_end_stroke(mk, NULL);
+    if (mk->applied <= mk->hist_first) return false;
+    apply_deltas(mk, &mk->hist[mk->applied - 1 - mk->hist_first], false, dirty);
+    mk->applied--;
+    return true;
+}
+
+bool rs_makeup_redo(rs_makeup *mk, rs_makeup_range *dirty)
+{
+    if (dirty) *dirty = (rs_makeup_range){0, 0};
+    if (mk->in_stroke) rs_makeup_end_stroke(mk, NULL);
+    if (mk->applied >= mk->stroke_count) return false;
+    apply_deltas(mk, &mk->hist[mk->applied - mk->hist_first], true, dirty);
+    mk->applied++;
+    return true;
+}
+
+rs_result rs_makeup_clear(rs_makeup *mk, rs_makeup_range *dirty, rs_error *err)
+{
+    if (dirty) *dirty = (rs_makeup_range){0, 0};
+    if (mk->in_stroke) rs_makeup_end_stroke(mk, NULL);
+    static const rs_makeup_gpu zero;
+    uint32_t changed = 0;
+    for (uint32_t i = 0; i < mk->n; i++)
+        if (mk->touch[i] || memcmp(&mk->rec[i], &zero, sizeof zero) != 0) changed++;
+    if (changed == 0) return RS_OK;
+    delta *d = rs_alloc_array(changed, sizeof *d);
+    if (!d || !grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes)) {
+        free(d);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: clear: out of memory");
+    }
+    rs_makeup_range r = {0, 0};
+    uint32_t j = 0;
+    for (uint32_t i = 0; i < mk->n; i++) {
+        if (!mk->touch[i] && memcmp(&mk->rec[i], &zero, sizeof zero) == 0) continue;
+        d[j++] = (delta){i, mk->rec[i], zero, mk->touch[i], 0};
+        mk->rec[i] = zero;
+        mk->touch[i] = 0;
+        extend(&r, i);
+        mark(mk, i);
+    }
+    if (dirty) *dirty = r;
+    log_push_stroke(mk, mk->stamp_count, 0, true);
+    return push_history(mk, d, changed, err);
+}
+
+void rs_makeup_reset(rs_makeup *mk, rs_makeup_range *dirty)
+{
+    rs_makeup_cancel_stroke(mk, NULL);
+    memset(mk->rec, 0, (size_t)mk->n * sizeof *mk->rec);
+    memset(mk->touch, 0, mk->n);
+    free_history(mk, 0);
+    mk->hist_first = mk->stroke_count = mk->applied = mk->stamp_count = mk->cosmetic_count = 0;
+    mark_all(mk);
+    if (dirty) *dirty = (rs_makeup_range){0, mk->n};
+}
+
+void rs_makeup_forget_history(rs_makeup *mk)
+{
+    if (mk->in_stroke) rs_makeup_end_stroke(mk, NULL);
+    truncate_redo(mk);
+    mk->stamp_count = applied_stamp_end(mk);
+    forget_all_history(mk);
+}
+
+static uint32_t log_start(const rs_makeup *mk)
+{
+    for (uint32_t k = mk->applied; k > 0; k--)
+        if (mk->strokes[k - 1].clear) return mk->strokes[k - 1].first;
+    return 0;
+}
+
+uint32_t rs_makeup_log_count(const rs_makeup *mk) { return applied_stamp_end(mk) - log_start(mk); }
+const rs_makeup_applied *rs_makeup_log_stamps(const rs_makeup *mk)
+{
+    return mk->stamps ? mk->stamps + log_start(mk) : NULL;
+}
+uint32_t rs_makeup_log_cosmetic_count(const rs_makeup *mk) { return mk->cosmetic_count; }
+
+const rs_cosmetic *rs_makeup_log_cosmetic(const rs_makeup *mk, uint32_t i)
+{
+    return i < mk->cosmetic_count ? &mk->cosmetics[i] : NULL;
+}
+
+uint32_t rs_makeup_take_dirty(rs_makeup *mk, rs_makeup_range *out, uint32_t cap)
+{
+    uint32_t n = 0;
+    for (uint32_t b = 0; b < mk->band_count; b++) {
+        rs_makeup_range r = mk->band_dirty[b];
+        mk->band_dirty[b] = (rs_makeup_range){0, 0};
+        if (r.lo >= r.hi || cap == 0) continue;
+        if (n < cap) {
+            out[n++] = r;
+        } else {
+            // Too little room: widen the last range (still correct, uploads more).
+            out[n - 1].lo = RS_MIN(out[n - 1].lo, r.lo);
+            out[n - 1].hi = RS_MAX(out[n - 1].hi, r.hi);
+        }
+    }
+    return n;
+}
