@@ -46,19 +46,19 @@ deps:
 # Include paths say who may use what: the library sees only src/; the app adds app/, the tools tools/.
 $(BUILD)/obj/src/%.o: src/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -fPIC -Iinclude -Isrc -c $< -o $@
 
 $(BUILD)/obj/app/%.o: app/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -Iapp -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Iinclude -Isrc -Iapp -c $< -o $@
 
 $(BUILD)/obj/tools/%.o: tools/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -Itools -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Iinclude -Isrc -Itools -c $< -o $@
 
 $(BUILD)/obj/tests/%.o: tests/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -Iapp -Itools -Itests -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Iinclude -Isrc -Iapp -Itools -Itests -c $< -o $@
 
 # Shaders are embedded at build time so an installed binary needs no shader directory.
 $(BUILD)/embed_shaders: tools/embed_shaders.c
@@ -71,7 +71,7 @@ $(BUILD)/gen/shaders.c: $(BUILD)/embed_shaders $(SHADERS)
 
 $(BUILD)/obj/gen/shaders.o: $(BUILD)/gen/shaders.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Isrc -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -fPIC -Isrc -c $< -o $@
 
 $(BUILD)/librouge.a: $(LIB_OBJ)
 	@rm -f $@

@@ -6,16 +6,17 @@
 #define RS_APP_APP_H
 
 #include "cli.h"
+#include "rouge.h"
 
 #define RS_APP_VERSION "0.1.0"
 #define RS_APP_DEFAULT_FACE "assets/face.rsf"
 
 // Headless: load the face, apply --look / --strokes, render the view to cli->output (atomic PNG write).
 rs_result rs_app_render(const rs_cli *cli, rs_error *err);
-// Applies --look, then replays --strokes (picking through the renderer), then --save-look. May change
-// the view to the one recorded in the stroke file (options given on the command line win).
-rs_result rs_app_apply_painting(const rs_cli *cli, const rs_splat_cloud *cloud, rs_renderer *ren, rs_view *view,
-                                rs_error *err);
+// The command line's view (every field explicit) as the public API's view.
+rouge_view rs_app_public_view(const rs_view *v);
+// A public API failure as the app's error (same codes, same message); returns the code.
+rs_result rs_app_error(rouge_result r, const rouge_error *e, rs_error *err);
 // The GLFW viewer (viewer.c).
 rs_result rs_app_view(const rs_cli *cli, rs_error *err);
 void rs_app_print_viewer_help(FILE *f);

@@ -1,27 +1,75 @@
-// render_cmd.c — `rouge render`: headless EGL render of a face (optionally painted) to a PNG.
+// render_cmd.c — `rouge render`: a headless EGL context, the face through the public API (rouge.h, as any
+// host uses it), --look, --strokes, --save-look, one frame written to a PNG.
 #include "app.h"
 
-#include <string.h>
+#include "rouge.h"
+
+rouge_view rs_app_public_view(const rs_view *v)
+{
+    rouge_view p = {
+        .width = v->width, .height = v->height, .yaw_deg = v->yaw_deg, .pitch_deg = v->pitch_deg,
+        .zoom = v->zoom, .fov_deg = v->fov_deg, .pan = {v->pan[0], v->pan[1]},
+        // A key light with intensity 0 is still "given" (not the default): rouge.h's zero rule.
+        .key = {v->key.yaw_deg, v->key.pitch_deg, {v->key.color[0], v->key.color[1], v->key.color[2]},
+                v->key.intensity > 0 ? v->key.intensity : 1.0f},
+        .fill = {v->fill.yaw_deg, v->fill.pitch_deg, {v->fill.color[0], v->fill.color[1], v->fill.color[2]},
+                 v->fill.intensity},
+        .ambient = v->ambient > 0 ? v->ambient : -1.0f,
+        .mode = (rouge_mode)v->mode,
+        .pipeline = v->pipeline == RS_PIPELINE_MOBILE ? ROUGE_PIPELINE_MOBILE : ROUGE_PIPELINE_REFERENCE,
+        .composite = v->composite == RS_COMPOSITE_PHYSICAL ? ROUGE_COMPOSITE_PHYSICAL : ROUGE_COMPOSITE_PAPER,
+        .exposure = v->exposure,
+        .background = {v->background[0], v->background[1], v->background[2], 1.0f},
+        .no_shadows = v->no_shadows, .hide_makeup = v->hide_makeup, .specular_scale = v->rho_s_scale,
+        .max_splats = v->max_splats, .kernel_count = v->kernel_count, .lod_density = v->lod_density,
+        .primitive = (rouge_primitive)v->prim,
+    };
+    return p;
+}
+
+rs_result rs_app_error(rouge_result r, const rouge_error *e, rs_error *err)
+{
+    if (r != ROUGE_OK) rs_fail(err, (rs_result)r, "%s", e->msg);
+    return (rs_result)r;
+}
+
+// --look, then --strokes (the camera follows the recording unless the command line chose it), then
+// --save-look.
+static rouge_result paint(const rs_cli *cli, rouge_face *face, rouge_error *e)
+{
+    rouge_result r = ROUGE_OK;
+    if (cli->look) r = rouge_face_load_look(face, cli->look, e);
+    if (!r && cli->strokes) {
+        rouge_view cam = rouge_face_get_view(face), v = rs_app_public_view(&cli->view);
+        r = rouge_face_play_strokes(face, cli->strokes, e);
+        cam = rouge_face_get_view(face);
+        if (!cli->view_set[0]) v.yaw_deg = cam.yaw_deg;
+        if (!cli->view_set[1]) v.pitch_deg = cam.pitch_deg;
+        if (!cli->view_set[2]) v.zoom = cam.zoom;
+        if (!cli->view_set[3]) v.fov_deg = cam.fov_deg;
+        if (!r) r = rouge_face_set_view(face, &v, e);
+    }
+    if (!r && cli->save_look) r = rouge_face_save_look(face, cli->save_look, e);
+    return r;
+}
 
 rs_result rs_app_render(const rs_cli *cli, rs_error *err)
 {
     if (!cli->face) return rs_fail(err, RS_ERR_ARG, "render: no face file given (usage: rouge render FACE.rsf -o OUT.png)");
     if (!cli->output) return rs_fail(err, RS_ERR_ARG, "render: no output given (-o OUT.png)");
-    rs_splat_cloud *cloud = NULL;
-    rs_result r = rs_splat_load(cli->face, &cloud, err);
-    if (r) return r;
+    if (cli->save_look && !cli->look && !cli->strokes)
+        return rs_fail(err, RS_ERR_ARG, "--save-look needs --look or --strokes to save");
     rs_gl_context *gl = NULL;
-    rs_renderer *ren = NULL;
-    rs_image img = {0};
-    rs_view view = cli->view;
-    r = rs_gl_create(&(rs_gl_desc){0}, &gl, err);
-    if (!r) r = rs_render_create(&(rs_render_desc){.cloud = cloud, .caps = rs_gl_get_caps(gl)}, &ren, err);
-    if (!r) r = rs_app_apply_painting(cli, cloud, ren, &view, err);
-    if (!r) r = rs_render_image(ren, &view, &img, err);
-    if (!r) r = rs_image_write_png(cli->output, &img, err);
-    rs_image_free(&img);
-    rs_render_destroy(ren);
+    rs_result rr = rs_gl_create(&(rs_gl_desc){0}, &gl, err);
+    if (rr) return rr;
+    rouge_error e = {0};
+    rouge_face *face = NULL;
+    rouge_view view = rs_app_public_view(&cli->view);
+    rouge_result r = rouge_face_create(&(rouge_face_desc){.path = cli->face, .view = &view}, &face, &e);
+    if (!r) r = paint(cli, face, &e);
+    if (!r) r = rouge_face_render(face, &e);
+    if (!r) r = rouge_face_write_png(face, cli->output, &e);
+    rouge_face_destroy(face);
     rs_gl_destroy(gl);
-    rs_splat_destroy(cloud);
-    return r;
+    return rs_app_error(r, &e, err);
 }

@@ -1,0 +1,316 @@
+// rouge.h — embed rouge: realistic skin rendering of a point-sampled face scan (the paper's subsurface
+// scattering + measured specular) and touch makeup painting on it, in your own OpenGL ES 3 context.
+//
+// DOES:
+//   - load a face (.rsf, from a file or memory) into a rouge_face that owns the splat cloud, the renderer,
+//     the makeup layer and the painting session;
+//   - render it into your current GLES 3.0 context: into the framebuffer you have bound (rouge_face_draw),
+//     or into an RGBA8 texture it owns (rouge_face_render + rouge_face_texture); every GL state it
+//     touches (framebuffers, viewport, program, VAO, buffers, textures, blend/depth/scissor/stencil/cull,
+//     masks, pixel-store alignment) is restored before it returns;
+//   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
+//     through an ID buffer, one- and two-finger navigation; brush, eraser, mirror, undo / redo / clear;
+//   - save and load looks (the makeup) as files or memory; record and replay stroke files;
+//   - report capabilities of a context you made (rouge_query_caps), picks and statistics.
+// DOES NOT:
+//   - create windows or contexts, or read input devices (your app, GLFW, SDL, Android... does; see
+//     examples/embed_headless.c for EGL and examples/glfw_painter.c for GLFW);
+//   - print, exit, or keep global state: every failure is a rouge_result plus a one-line message in
+//     the rouge_error you pass (may be NULL);
+//   - block: except the file functions (they read / write files) and rouge_face_create (parses the face,
+//     compiles shaders), calls return after queueing GL work; rouge_face_read_rgba, rouge_face_write_png
+//     and rouge_face_pick wait for the GPU.
+//   - work on several threads at once: call a face from the thread whose context is current, the same
+//     context (or one sharing its objects) for its whole life.
+//
+// Structs are options: their zero value means the documented default (so `(rouge_view){0}` is the
+// default view, `(rouge_brush){.cosmetic = "blush"}` a blush with its own size and opacity).
+//
+//   rouge_error err;
+//   rouge_face *face;
+//   if (rouge_face_create(&(rouge_face_desc){.path = "face.rsf"}, &face, &err) != ROUGE_OK)
+//       return fprintf(stderr, "%s\n", err.msg), 1;
+//   rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "lipstick_satin"}, &err);
+//   // per frame, with your context current and your framebuffer bound:
+//   rouge_face_pointer(face, &(rouge_pointer_event){ROUGE_POINTER_DOWN, 0, x, y}, NULL, &err);
+//   rouge_face_draw(face, 0, 0, 0, 0, &err);          // fills the current viewport
+//   rouge_face_destroy(face);
+//
+// Link with `pkg-config --cflags --libs rouge`. Names starting rouge_ / ROUGE_ are the public API;
+// everything else in the library (rs_*) is internal and may change.
+#ifndef ROUGE_H
+#define ROUGE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define ROUGE_VERSION_MAJOR 0
+#define ROUGE_VERSION_MINOR 1
+#define ROUGE_VERSION_PATCH 0
+
+// --- errors ------------------------------------------------------------------------------------------
+
+typedef enum rouge_result {
+    ROUGE_OK = 0,
+    ROUGE_ERR_IO,      // file system: missing, unreadable, unwritable
+    ROUGE_ERR_FORMAT,  // malformed file or buffer contents
+    ROUGE_ERR_LIMIT,   // a count or size beyond what rouge accepts
+    ROUGE_ERR_NOMEM,   // out of memory
+    ROUGE_ERR_GL,      // no current GLES 3 context, shader or framebuffer failure
+    ROUGE_ERR_ARG,     // bad argument (unknown cosmetic, view out of range, ...)
+} rouge_result;
+
+// The detail of a failure: "face.rsf: header: bad CRC (byte 8)". Untouched on success.
+typedef struct rouge_error {
+    rouge_result code;
+    char msg[512];
+} rouge_error;
+
+const char *rouge_result_name(rouge_result r);  // "ROUGE_ERR_IO"
+void rouge_free(void *p);                        // frees memory rouge handed you (looks in memory)
+
+// --- the GL context you made ---------------------------------------------------------------------------
+
+typedef struct rouge_caps {
+    int gles_major, gles_minor;
+    char renderer[128];      // GL_RENDERER
+    char version[128];       // GL_VERSION
+    bool float_targets;      // RGBA16F render targets: the full-precision path (else an RGBA8 fallback)
+    float point_size_max;    // GL_ALIASED_POINT_SIZE_RANGE (splats beyond it are drawn as quads)
+    int max_draw_buffers;
+    int max_texture_size;
+} rouge_caps;
+
+// What rouge sees of the context current on this thread. ROUGE_ERR_GL when none is current or it is
+// not GLES 3.
+rouge_result rouge_query_caps(rouge_caps *out, rouge_error *err);
+
+// --- the view: camera, light, what is drawn --------------------------------------------------------------
+
+typedef enum rouge_mode {
+    ROUGE_MODE_FULL = 0,    // subsurface + specular
+    ROUGE_MODE_ALBEDO,      // colour only, no lighting
+    ROUGE_MODE_DIFFUSE,     // subsurface only
+    ROUGE_MODE_SPECULAR,    // debug views from here on
+    ROUGE_MODE_NORMALS,
+    ROUGE_MODE_REGIONS,
+    ROUGE_MODE_SHADOW,
+    ROUGE_MODE_LOD,
+    ROUGE_MODE_IRRADIANCE,
+    ROUGE_MODE_COUNT
+} rouge_mode;
+
+typedef enum rouge_pipeline {
+    ROUGE_PIPELINE_DEFAULT = 0,  // mobile
+    ROUGE_PIPELINE_MOBILE,       // LOD decimation + 3 Gaussians: matched to the reference within 34 dB per view
+    ROUGE_PIPELINE_REFERENCE,    // all splats, six Gaussians: the quality bar (slow)
+} rouge_pipeline;
+
+typedef enum rouge_primitive {
+    ROUGE_PRIMITIVE_AUTO = 0,    // point sprites when they are large enough, else instanced quads
+    ROUGE_PRIMITIVE_POINTS,
+    ROUGE_PRIMITIVE_QUADS,
+} rouge_primitive;
+
+typedef enum rouge_composite {
+    ROUGE_COMPOSITE_PAPER = 0,   // F = A (D + S)
+    ROUGE_COMPOSITE_PHYSICAL,    // F = A D + S
+} rouge_composite;
+
+// A directional light, given as the direction it comes FROM in the face's frame (0, 0: from the front,
+// + yaw towards the subject's left, + pitch from above).
+typedef struct rouge_light {
+    float yaw_deg, pitch_deg;
+    float color[3];     // linear RGB; all zero = white
+    float intensity;    // 0 = 1 (key light); the fill light is on only when intensity > 0
+} rouge_light;
+
+typedef struct rouge_view {
+    int width, height;           // render size in pixels; 0 = the draw rectangle's (or 512 x 512)
+    float yaw_deg, pitch_deg;    // camera orbiting the face centre; 0, 0 = frontal
+    float zoom;                  // 0 = 1: the face height fills ~80% of the view height; 2 = twice as close
+    float fov_deg;               // vertical field of view; 0 = 30
+    float pan[2];                // screen shift, fractions of the view height (+x right, +y down)
+    rouge_light key;             // all zero = the default key light (yaw -35, pitch 30: upper left-front, white, 1)
+    rouge_light fill;            // all zero = no fill light
+    float ambient;               // uniform sky light; 0 = 0.05, negative = none
+    const char *env;             // lighting environment by name; NULL or "" = the key/fill lights above
+    float env_rotation_deg;      // environment turned about the face's up axis
+    rouge_mode mode;
+    rouge_pipeline pipeline;
+    rouge_composite composite;
+    float exposure;              // linear multiplier before sRGB; 0 = 1
+    float background[4];         // sRGB 0..1 + alpha; alpha 0 = the default dark grey
+    bool no_shadows;
+    bool hide_makeup;            // the bare face (a before / after comparison)
+    float specular_scale;        // multiplies the skin's specular; 0 = 1 (2 = oily skin)
+    uint32_t max_splats;         // cap on the splats drawn (an LOD prefix); 0 = the pipeline decides
+    int kernel_count;            // mobile: Gaussians of the subsurface profile (2..4); 0 = 3
+    float lod_density;           // mobile: visible splats per face pixel; 0 = 0.3
+    rouge_primitive primitive;   // how splats are rasterised (a debugging choice; both agree)
+} rouge_view;
+
+// --- the face ------------------------------------------------------------------------------------------
+
+typedef struct rouge_face rouge_face;
+
+typedef struct rouge_face_desc {
+    const char *path;            // a .rsf file; or
+    const void *data;            // the bytes of one (not kept after create)
+    size_t size;
+    const rouge_view *view;      // the initial view; NULL = (rouge_view){0}
+    uint32_t undo_levels;        // strokes kept for undo; 0 = 64
+    bool manual_navigation;      // pointer gestures only report orbit / pan / zoom, the camera stays
+    bool no_float_targets;       // force the RGBA8 fallback (tests; drivers with broken float blending)
+} rouge_face_desc;
+
+// Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
+rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, rouge_error *err);
+// With the creating context current. NULL is fine.
+void rouge_face_destroy(rouge_face *face);
+
+// The view (copied, also the env string). ROUGE_ERR_ARG for an unknown mode, pipeline or environment;
+// the previous view stays then.
+rouge_result rouge_face_set_view(rouge_face *face, const rouge_view *view, rouge_error *err);
+// The view as set, with the camera as navigation left it.
+rouge_view rouge_face_get_view(const rouge_face *face);
+// Navigation in pixels of the last frame (what gestures do; for keys, wheels and your own gestures).
+void rouge_face_orbit(rouge_face *face, float yaw_deg, float pitch_deg);
+void rouge_face_pan(rouge_face *face, float dx_px, float dy_px);
+void rouge_face_zoom_at(rouge_face *face, float factor, float x_px, float y_px);  // keeps (x, y) in place
+
+// --- drawing -------------------------------------------------------------------------------------------
+
+// Renders the face into the rectangle (x, y, w, h) of the framebuffer bound for drawing (GL pixels,
+// origin bottom-left); w or h 0 = the current viewport. Rendered at the view's size (0 = the rectangle's)
+// and copied (scaled when sizes differ). The target must be single-sampled.
+rouge_result rouge_face_draw(rouge_face *face, int x, int y, int w, int h, rouge_error *err);
+// Renders into the face's own texture only (view size; 0 = 512 x 512).
+rouge_result rouge_face_render(rouge_face *face, rouge_error *err);
+// The last frame: a GL texture name (GLuint; RGBA8, rows bottom-first as GL has them) owned by the face,
+// valid until the next render or destroy; 0 before the first frame.
+uint32_t rouge_face_texture(const rouge_face *face, int *width, int *height);
+// The last frame as RGBA8, rows top-first, into rgba (at least width * height * 4 bytes).
+rouge_result rouge_face_read_rgba(rouge_face *face, uint8_t *rgba, size_t capacity, rouge_error *err);
+// The last frame as a PNG (written to a temporary file and renamed: never half-written).
+rouge_result rouge_face_write_png(rouge_face *face, const char *path, rouge_error *err);
+// True when the view or the makeup changed since the last frame (a host that redraws on demand asks).
+bool rouge_face_changed(const rouge_face *face);
+
+// --- painting ------------------------------------------------------------------------------------------
+
+typedef enum rouge_pointer_type {
+    ROUGE_POINTER_DOWN = 0,
+    ROUGE_POINTER_MOVE,
+    ROUGE_POINTER_UP,
+    ROUGE_POINTER_CANCEL,  // the system took the pointer back (palm rejection): the stroke is rolled back
+} rouge_pointer_type;
+
+typedef struct rouge_pointer_event {
+    rouge_pointer_type type;
+    int id;            // the touch / pointer id; two ids down at once pinch and pan
+    float x, y;        // pixels of the last frame (view size), origin top-left
+    float pressure;    // 0..1; 0 = 1 (a mouse)
+    double time_s;     // any monotonic clock, seconds
+} rouge_pointer_event;
+
+typedef struct rouge_pointer_result {
+    uint32_t stamps;                 // brush stamps applied
+    uint32_t misses;                 // stamps that fell on the background
+    bool stroke_begin, stroke_end, stroke_cancel;
+    float orbit_dx, orbit_dy;        // one-finger drag when not painting, pixels
+    float pan_dx, pan_dy;            // two-finger drag, pixels
+    float zoom, zoom_x, zoom_y;      // pinch factor (1 = none) and centre
+} rouge_pointer_result;
+
+typedef enum rouge_pressure {
+    ROUGE_PRESSURE_FLOOR = 0,   // opacity * (0.3 + 0.7 p): a light touch still paints
+    ROUGE_PRESSURE_LINEAR,      // opacity * p
+    ROUGE_PRESSURE_NONE,
+} rouge_pressure;
+
+typedef struct rouge_brush {
+    const char *cosmetic;        // a preset name (rouge_cosmetic_get); NULL = "foundation_1"
+    float color[3];              // sRGB 0..1 replacing the preset's colour (its finish kept); all 0 = the preset's
+    float size;                  // diameter as a fraction of the face height; 0 = the cosmetic's
+    float opacity;               // 0..1; 0 = the cosmetic's
+    rouge_pressure pressure;
+    bool eraser, mirror;         // mirror: also paint the mirror image across the face's mid-plane
+} rouge_brush;
+
+typedef struct rouge_cosmetic {
+    const char *name;            // "lipstick_satin"
+    const char *kind;            // "lipstick"
+    uint8_t rgb[3];              // sRGB
+    float size, opacity;         // its default brush
+} rouge_cosmetic;
+
+int rouge_cosmetic_count(void);
+bool rouge_cosmetic_get(int i, rouge_cosmetic *out);  // false when i is out of range
+
+// ROUGE_ERR_ARG for an unknown cosmetic (the brush stays). Takes effect at the next stroke.
+rouge_result rouge_face_set_brush(rouge_face *face, const rouge_brush *brush, rouge_error *err);
+// One pointer paints (true, the default) or orbits (false); two always pinch and pan.
+void rouge_face_set_painting(rouge_face *face, bool painting);
+// Feeds one event; `out` may be NULL. Picks use the last frame's view (draw or render first).
+rouge_result rouge_face_pointer(rouge_face *face, const rouge_pointer_event *ev, rouge_pointer_result *out,
+                                rouge_error *err);
+bool rouge_face_undo(rouge_face *face);   // false when there is nothing to undo
+bool rouge_face_redo(rouge_face *face);
+rouge_result rouge_face_clear(rouge_face *face, rouge_error *err);  // undoable
+
+// --- looks and stroke files -------------------------------------------------------------------------------
+
+rouge_result rouge_face_load_look(rouge_face *face, const char *path, rouge_error *err);
+rouge_result rouge_face_load_look_memory(rouge_face *face, const void *data, size_t size, rouge_error *err);
+rouge_result rouge_face_save_look(rouge_face *face, const char *path, rouge_error *err);
+// *data (free with rouge_free) holds *size bytes of look text.
+rouge_result rouge_face_save_look_memory(rouge_face *face, char **data, size_t *size, rouge_error *err);
+// Records each stroke painted from now on to a stroke file (saved after every stroke); NULL stops.
+rouge_result rouge_face_record_strokes(rouge_face *face, const char *path, rouge_error *err);
+// Replays a stroke file (each stroke seen through the camera it was recorded with); the camera is
+// left at the last stroke's.
+rouge_result rouge_face_play_strokes(rouge_face *face, const char *path, rouge_error *err);
+
+// --- queries -------------------------------------------------------------------------------------------
+
+typedef struct rouge_pick {
+    uint32_t splat;              // index in the face's cloud
+    float position[3];           // the surface point under the pixel, model units
+    int region;                  // 0 other, 1 cheek, 2 nose, 3 forehead, 4 lips, ...
+    float brush_radius_px;       // the current brush's radius on screen at that point
+} rouge_pick;
+
+// The face under pixel (x, y) of the last frame (top-left origin); false on background.
+bool rouge_face_pick(rouge_face *face, float x, float y, rouge_pick *out);
+
+#define ROUGE_MAX_LODS 24
+
+typedef struct rouge_stats {
+    uint32_t splats;             // in the face
+    uint32_t lod_count;          // LOD prefixes: lods[0] = splats > lods[1] > ...
+    uint32_t lods[ROUGE_MAX_LODS];
+    float face_height_mm;
+    uint32_t splats_drawn;       // last frame
+    uint32_t auto_splats;        // what the current view would draw with max_splats 0 (the mobile LOD)
+    int kernel_count;            // Gaussians of the last frame's subsurface pass
+    int width, height;           // last frame
+    double frame_ms;             // last frame's render time (CPU wall clock; GL work may still run)
+    bool float_targets;
+    size_t gpu_bytes;
+    bool can_undo, can_redo, in_stroke;
+    uint32_t look_stamps;        // stamps that make the current makeup
+    uint32_t uploaded_records;   // makeup records sent to the GPU by the last frame (dirty LOD bands)
+} rouge_stats;
+
+rouge_stats rouge_face_stats(const rouge_face *face);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

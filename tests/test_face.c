@@ -1,0 +1,280 @@
+// test_face.c — the public face object (include/rouge.h) against the internal renderer it wraps: a zero
+// view renders exactly what rs_view_defaults() renders; drawing into a host's framebuffer leaves every
+// piece of the host's GL state as it was and puts exactly the face's frame into the host's viewport;
+// painting through pointer events changes the picture, and undo / redo / looks in memory restore it bit
+// for bit; only the dirty LOD bands are uploaded; bad arguments come back as values with a message.
+// The bundled face from a 30k-splat LOD prefix at 96x96 (a few seconds on llvmpipe).
+#include "support/harness.h"
+#include "gl/gl.h"
+#include "render/render.h"
+#include "rouge.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SIZE 96
+#define MAX_SPLATS 30000
+#define FACE "assets/face.rsf"
+
+static rs_gl_context *gl;
+static rouge_face *face;
+
+static rouge_view small_view(void)
+{
+    return (rouge_view){.width = SIZE, .height = SIZE, .max_splats = MAX_SPLATS, .pipeline = ROUGE_PIPELINE_REFERENCE};
+}
+
+// Renders the face's current view and reads it back (top-first RGBA).
+static bool frame(rs_image *img)
+{
+    rouge_error e = {0};
+    if (!RS_CHECK(rouge_face_render(face, &e) == ROUGE_OK, "render: %s", e.msg)) return false;
+    if (rs_image_create(SIZE, SIZE, 4, img, NULL) != RS_OK) return false;
+    return RS_CHECK(rouge_face_read_rgba(face, img->pixels, (size_t)SIZE * SIZE * 4, &e) == ROUGE_OK, "read: %s", e.msg);
+}
+
+static bool same(const rs_image *a, const rs_image *b)
+{
+    return a->width == b->width && a->height == b->height &&
+           !memcmp(a->pixels, b->pixels, (size_t)a->width * (size_t)a->height * 4);
+}
+
+static int changed_pixels(const rs_image *a, const rs_image *b)
+{
+    int n = 0;
+    for (size_t i = 0; i < (size_t)a->width * (size_t)a->height; i++)
+        for (int c = 0; c < 3; c++)
+            if (abs(a->pixels[i * 4 + c] - b->pixels[i * 4 + c]) > 2) {
+                n++;
+                break;
+            }
+    return n;
+}
+
+static void test_zero_view_is_the_default_view(void)
+{
+    rouge_view v = {.width = SIZE, .height = SIZE, .max_splats = MAX_SPLATS};
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    rs_image a = {0}, b = {0};
+    if (!frame(&a)) return;
+    // The same face through the internal renderer with its documented defaults (mobile, as rouge.h's 0).
+    rs_splat_cloud *c = NULL;
+    rs_renderer *r = NULL;
+    rs_error re = {0};
+    RS_REQUIRE(rs_splat_load(FACE, &c, &re) == RS_OK, "%s", re.msg);
+    rs_view d = rs_view_defaults();
+    d.width = d.height = SIZE, d.max_splats = MAX_SPLATS, d.pipeline = RS_PIPELINE_MOBILE;
+    if (RS_CHECK(rs_render_create(&(rs_render_desc){.cloud = c, .caps = rs_gl_get_caps(gl)}, &r, &re) == RS_OK, "%s", re.msg) &&
+        RS_CHECK(rs_render_image(r, &d, &b, &re) == RS_OK, "%s", re.msg))
+        RS_CHECK(same(&a, &b), "zero rouge_view differs from rs_view_defaults() (%d pixels)", changed_pixels(&a, &b));
+    rs_render_destroy(r);
+    rs_splat_destroy(c);
+    rs_image_free(&a);
+    rs_image_free(&b);
+}
+
+// A host's framebuffer with odd state everywhere; rouge_face_draw must render into its viewport and
+// leave all of it as it found it.
+static void test_draw_into_host_framebuffer_restores_state(void)
+{
+    rouge_view v = small_view();
+    v.width = v.height = 0;  // the viewport's size
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    GLuint tex, fbo, vao, buf, tex3;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, 160, 120);
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
+    glClearColor(1, 0, 1, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &buf);
+    glBindBuffer(GL_ARRAY_BUFFER, buf);
+    glGenTextures(1, &tex3);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, tex3);
+    glViewport(20, 10, SIZE, SIZE);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, 0, 30, 30);
+    glEnable(GL_BLEND);
+    glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ZERO);
+    glEnable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_FALSE);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glPixelStorei(GL_PACK_ALIGNMENT, 8);
+
+    rouge_result r = rouge_face_draw(face, 0, 0, 0, 0, &e);
+    RS_CHECK(r == ROUGE_OK, "draw: %s", e.msg);
+    GLint i4[4], i;
+    glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &i);
+    RS_CHECK(i == (GLint)fbo, "draw framebuffer %d, host had %u", i, fbo);
+    glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &i);
+    RS_CHECK(i == (GLint)fbo, "read framebuffer %d", i);
+    glGetIntegerv(GL_VIEWPORT, i4);
+    RS_CHECK(i4[0] == 20 && i4[1] == 10 && i4[2] == SIZE && i4[3] == SIZE, "viewport %d %d %d %d", i4[0], i4[1], i4[2], i4[3]);
+    glGetIntegerv(GL_SCISSOR_BOX, i4);
+    RS_CHECK(i4[2] == 30 && glIsEnabled(GL_SCISSOR_TEST), "scissor");
+    RS_CHECK(glIsEnabled(GL_BLEND) && glIsEnabled(GL_CULL_FACE) && glIsEnabled(GL_DEPTH_TEST), "enables");
+    glGetIntegerv(GL_BLEND_SRC_RGB, &i);
+    RS_CHECK(i == GL_SRC_ALPHA, "blend func");
+    glGetIntegerv(GL_DEPTH_FUNC, &i);
+    RS_CHECK(i == GL_GREATER, "depth func");
+    GLboolean dm;
+    glGetBooleanv(GL_DEPTH_WRITEMASK, &dm);
+    RS_CHECK(!dm, "depth mask");
+    glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &i);
+    RS_CHECK(i == (GLint)vao, "vertex array");
+    glGetIntegerv(GL_ARRAY_BUFFER_BINDING, &i);
+    RS_CHECK(i == (GLint)buf, "array buffer");
+    glGetIntegerv(GL_ACTIVE_TEXTURE, &i);
+    RS_CHECK(i == GL_TEXTURE3, "active texture");
+    glGetIntegerv(GL_TEXTURE_BINDING_2D, &i);
+    RS_CHECK(i == (GLint)tex3, "texture on unit 3");
+    glGetIntegerv(GL_PACK_ALIGNMENT, &i);
+    RS_CHECK(i == 8, "pack alignment");
+    RS_CHECK(glGetError() == GL_NO_ERROR, "GL error after draw");
+
+    // The viewport holds exactly the face's frame; outside it the host's clear colour stays.
+    rs_image want = {0};
+    uint8_t *px = malloc(160 * 120 * 4);
+    if (RS_CHECK(px && rs_image_create(SIZE, SIZE, 4, &want, NULL) == RS_OK, "alloc") &&
+        RS_CHECK(rouge_face_read_rgba(face, want.pixels, (size_t)SIZE * SIZE * 4, &e) == ROUGE_OK, "%s", e.msg)) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glReadPixels(0, 0, 160, 120, GL_RGBA, GL_UNSIGNED_BYTE, px);
+        int bad = 0;
+        for (int y = 0; y < 120; y++)
+            for (int x = 0; x < 160; x++) {
+                const uint8_t *p = px + ((size_t)y * 160 + (size_t)x) * 4;
+                bool in = x >= 20 && x < 20 + SIZE && y >= 10 && y < 10 + SIZE;
+                // read_rgba is top-first; GL rows bottom-first.
+                const uint8_t *q = in ? want.pixels + ((size_t)(SIZE - 1 - (y - 10)) * SIZE + (size_t)(x - 20)) * 4 : NULL;
+                bool ok = in ? !memcmp(p, q, 3) : (p[0] == 255 && p[1] == 0 && p[2] == 255);
+                bad += !ok;
+            }
+        RS_CHECK(bad == 0, "%d pixels of the host framebuffer differ from the face's frame / the host's clear", bad);
+    }
+    free(px);
+    rs_image_free(&want);
+    glDisable(GL_SCISSOR_TEST), glDisable(GL_BLEND), glDisable(GL_CULL_FACE), glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE), glDepthFunc(GL_LESS);
+    glActiveTexture(GL_TEXTURE0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glBindVertexArray(0);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteBuffers(1, &buf);
+    glDeleteFramebuffers(1, &fbo);
+    GLuint texs[2] = {tex, tex3};
+    glDeleteTextures(2, texs);
+}
+
+static rouge_result stroke(float x0, float y0, float x1, float y1, rouge_pointer_result *total)
+{
+    rouge_error e = {0};
+    rouge_pointer_result res;
+    *total = (rouge_pointer_result){0};
+    for (int i = 0; i <= 10; i++) {
+        float t = (float)i / 10.0f;
+        rouge_pointer_event ev = {i == 0 ? ROUGE_POINTER_DOWN : i == 10 ? ROUGE_POINTER_UP : ROUGE_POINTER_MOVE, 7,
+                                  x0 + (x1 - x0) * t, y0 + (y1 - y0) * t, 1.0f, 0.02 * i};
+        rouge_result r = rouge_face_pointer(face, &ev, &res, &e);
+        if (r) return r;
+        total->stamps += res.stamps;
+    }
+    return ROUGE_OK;
+}
+
+static void test_paint_undo_redo_and_look_in_memory(void)
+{
+    rouge_view v = small_view();
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .size = 0.15f, .opacity = 1}, &e) == ROUGE_OK,
+               "%s", e.msg);
+    rs_image bare = {0}, painted = {0}, undone = {0}, redone = {0}, looked = {0};
+    if (!frame(&bare)) return;
+    rouge_pick pk;
+    RS_CHECK(rouge_face_pick(face, SIZE * 0.5f, SIZE * 0.55f, &pk) && pk.brush_radius_px > 1, "pick at the centre");
+    rouge_pointer_result res;
+    RS_REQUIRE(stroke(SIZE * 0.35f, SIZE * 0.6f, SIZE * 0.65f, SIZE * 0.6f, &res) == ROUGE_OK, "stroke");
+    RS_CHECK(res.stamps > 3, "stamps %u", res.stamps);
+    RS_CHECK(rouge_face_changed(face), "painting marks the face changed");
+    if (!frame(&painted)) goto out;
+    rouge_stats st = rouge_face_stats(face);
+    RS_CHECK(st.uploaded_records > 0 && st.uploaded_records < st.splats / 4,
+             "uploaded %u of %u records: only the dirty LOD bands should go up", st.uploaded_records, st.splats);
+    RS_CHECK(!rouge_face_changed(face), "a frame clears the changed flag");
+    int n = changed_pixels(&bare, &painted);
+    RS_CHECK(n > 50, "the stroke changed %d pixels", n);
+    char *look = NULL;
+    size_t look_len = 0;
+    RS_CHECK(rouge_face_save_look_memory(face, &look, &look_len, &e) == ROUGE_OK && look_len > 0, "save: %s", e.msg);
+    RS_CHECK(rouge_face_undo(face), "undo");
+    if (!frame(&undone)) goto out;
+    RS_CHECK(same(&bare, &undone), "undo differs from the bare face (%d pixels)", changed_pixels(&bare, &undone));
+    RS_CHECK(rouge_face_redo(face), "redo");
+    if (!frame(&redone)) goto out;
+    RS_CHECK(same(&painted, &redone), "redo differs from the painted face");
+    RS_CHECK(rouge_face_clear(face, &e) == ROUGE_OK, "clear");
+    RS_CHECK(rouge_face_load_look_memory(face, look, look_len, &e) == ROUGE_OK, "load: %s", e.msg);
+    if (!frame(&looked)) goto out;
+    RS_CHECK(same(&painted, &looked), "look from memory differs from the painted face (%d pixels)",
+             changed_pixels(&painted, &looked));
+out:
+    rouge_free(look);
+    rouge_face_clear(face, NULL);
+    rs_image_free(&bare), rs_image_free(&painted), rs_image_free(&undone), rs_image_free(&redone);
+    rs_image_free(&looked);
+}
+
+static void test_errors_are_values(void)
+{
+    rouge_error e = {0};
+    RS_CHECK(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "mascara"}, &e) == ROUGE_ERR_ARG &&
+                 strstr(e.msg, "mascara"),
+             "unknown cosmetic: %s", e.msg);
+    RS_CHECK(rouge_face_set_view(face, &(rouge_view){.env = "moon"}, &e) == ROUGE_ERR_ARG && strstr(e.msg, "moon"),
+             "unknown environment: %s", e.msg);
+    RS_CHECK(rouge_face_set_view(face, &(rouge_view){.mode = (rouge_mode)99}, &e) == ROUGE_ERR_ARG, "bad mode");
+    rouge_face *f = NULL;
+    RS_CHECK(rouge_face_create(&(rouge_face_desc){.path = "tests/no/such.rsf"}, &f, &e) == ROUGE_ERR_IO && !f &&
+                 strstr(e.msg, "such.rsf"),
+             "missing face: %s", e.msg);
+    RS_CHECK(rouge_face_create(&(rouge_face_desc){.data = "RSF?", .size = 4}, &f, &e) == ROUGE_ERR_FORMAT && !f,
+             "garbage in memory: %s", e.msg);
+    RS_CHECK(rouge_face_load_look_memory(face, "rouge-look 9\n", 13, &e) != ROUGE_OK && e.msg[0], "bad look");
+    rouge_caps caps;
+    RS_CHECK(rouge_query_caps(&caps, &e) == ROUGE_OK && caps.gles_major >= 3 && caps.renderer[0], "caps: %s", e.msg);
+    RS_CHECK(!strcmp(rouge_result_name(ROUGE_ERR_GL), "ROUGE_ERR_GL"), "result names");
+}
+
+int main(int argc, char **argv)
+{
+    rs_test_init(argc, argv);
+    rs_error err = {0};
+    rouge_error e = {0};
+    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
+        printf("skip - test_face: %s\n", err.msg);
+        return rs_test_finish();
+    }
+    rouge_view v = small_view();
+    if (rouge_face_create(&(rouge_face_desc){.path = FACE, .view = &v}, &face, &e) != ROUGE_OK) {
+        printf("FAIL - test_face: %s\n", e.msg);
+        rs_gl_destroy(gl);
+        return 1;
+    }
+    RS_RUN(test_zero_view_is_the_default_view);
+    RS_RUN(test_draw_into_host_framebuffer_restores_state);
+    RS_RUN(test_paint_undo_redo_and_look_in_memory);
+    RS_RUN(test_errors_are_values);
+    rouge_face_destroy(face);
+    rs_gl_destroy(gl);
+    return rs_test_finish();
+}
