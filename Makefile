@@ -2,7 +2,10 @@
 #
 # Layout of outputs (all under $(BUILD), git-ignored):
 #   rouge, rouge-pack, rouge-imgdiff     programs
-#   librouge.a                           src/ (the library: no window-system or UI code)
+#   librouge.a, librouge.so.0            src/ (the library: no window-system or UI code; the .so exports
+#                                        only the public API of include/rouge.h)
+#   examples/                            examples/*.c built against the tree (tests/test_install.sh
+#                                        builds them against the installed package)
 #   libpack.a                            tools/pack/: the converter library (PLY reader, ...)
 #   gen/shaders.c                        shaders_es/*.glsl embedded at build time
 #   tests/test_*                         one test program per tests/test_*.c
@@ -32,12 +35,21 @@ TLIB_OBJ := $(TOOL_LIB:%.c=$(BUILD)/obj/%.o)
 TESTS    := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 PROGS    := $(BUILD)/rouge $(TOOL_PROG:tools/rouge_%.c=$(BUILD)/rouge-%)
 
-LIBS := $(BUILD)/libpack.a $(BUILD)/librouge.a $(PKG_LIBS) -lm
-# Tests also link the app's parts (UI, viewer, CLI) through libapp.a.
+# The library needs no window system: GLFW is the app's.
+LIB_PKGS := egl glesv2 libpng cglm
+LIB_LIBS := $(shell pkg-config --libs $(LIB_PKGS) 2>/dev/null) -lm
+LIBS := $(BUILD)/librouge.a $(PKG_LIBS) -lm
+# Tests also link the app's parts (UI, viewer, CLI) through libapp.a; the converter's tests libpack.
 TEST_LIBS := $(BUILD)/libapp.a $(LIBS)
+PACK_TESTS := test_pack test_ply
 
-.PHONY: all deps run test bench asan fuzz figures clean
-all: $(PROGS) $(TESTS)
+VERSION  := 0.1.0
+SOMAJOR  := 0
+SONAME   := librouge.so.$(SOMAJOR)
+EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
+
+.PHONY: all deps run test bench asan fuzz figures clean install uninstall
+all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES)
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
 deps:
@@ -86,17 +98,30 @@ $(BUILD)/libpack.a: $(TLIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(BUILD)/rouge: $(APP_OBJ) $(BUILD)/librouge.a $(BUILD)/libpack.a
+# The shared library exports rouge_* only (tools/librouge.map); everything rs_* stays inside.
+$(BUILD)/$(SONAME): $(LIB_OBJ) tools/librouge.map
+	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=tools/librouge.map $(LIB_OBJ) $(LIB_LIBS) $(LDFLAGS) -o $@
+
+# Examples use nothing but rouge.h (+ EGL / GLFW / libpng for their own needs).
+$(BUILD)/examples/%: examples/%.c include/rouge.h $(BUILD)/librouge.a
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Iinclude $< $(BUILD)/librouge.a $(PKG_LIBS) -lm $(LDFLAGS) -o $@
+
+$(BUILD)/rouge: $(APP_OBJ) $(BUILD)/librouge.a
 	$(CC) $(CFLAGS) $(APP_OBJ) $(LIBS) $(LDFLAGS) -o $@
 
-$(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a $(BUILD)/libpack.a
+# Only the converter links the converter library.
+$(BUILD)/rouge-pack: $(BUILD)/obj/tools/rouge_pack.o $(BUILD)/libpack.a $(BUILD)/librouge.a
+	$(CC) $(CFLAGS) $< $(BUILD)/libpack.a $(LIBS) $(LDFLAGS) -o $@
+
+$(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a
 	$(CC) $(CFLAGS) $< $(LIBS) $(LDFLAGS) -o $@
 
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(sort $(wildcard tests/support/*.c)))
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(TEST_LIBS) $(LDFLAGS) -o $@
+	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a) $(TEST_LIBS) $(LDFLAGS) -o $@
 
 run: deps
 	@$(MAKE) --no-print-directory all
@@ -124,6 +149,31 @@ figures: deps
 
 fuzz: deps
 	@sh tools/fuzz.sh
+
+# make install [PREFIX=/usr/local] [DESTDIR=]: the header, both libraries, rouge.pc, the programs and
+# the bundled face they open by default (share/rouge; the programs look there next to their bin/).
+PREFIX ?= /usr/local
+INSTALL_PROGS := $(BUILD)/rouge $(BUILD)/rouge-pack $(BUILD)/rouge-imgdiff $(BUILD)/rouge-profile
+I := $(DESTDIR)$(PREFIX)
+install: $(INSTALL_PROGS) $(BUILD)/librouge.a $(BUILD)/$(SONAME)
+	install -d $(I)/bin $(I)/include $(I)/lib/pkgconfig $(I)/share/rouge
+	install -m 755 $(INSTALL_PROGS) $(I)/bin/
+	install -m 644 include/rouge.h $(I)/include/
+	install -m 644 $(BUILD)/librouge.a $(I)/lib/
+	install -m 755 $(BUILD)/$(SONAME) $(I)/lib/$(SONAME).$(VERSION:$(SOMAJOR).%=%)
+	ln -sf $(SONAME).$(VERSION:$(SOMAJOR).%=%) $(I)/lib/$(SONAME)
+	ln -sf $(SONAME) $(I)/lib/librouge.so
+	printf '%s\n' 'prefix=$(PREFIX)' 'exec_prefix=$${prefix}' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
+	    'Name: rouge' 'Description: realistic skin rendering and makeup painting on face scans (OpenGL ES 3)' \
+	    'Version: $(VERSION)' 'Requires.private: $(LIB_PKGS)' 'Libs: -L$${libdir} -lrouge' 'Libs.private: -lm' \
+	    'Cflags: -I$${includedir}' > $(I)/lib/pkgconfig/rouge.pc
+	install -m 644 assets/face.rsf assets/README.md $(I)/share/rouge/
+
+uninstall:
+	rm -f $(addprefix $(I)/bin/,$(notdir $(INSTALL_PROGS))) $(I)/include/rouge.h $(I)/lib/librouge.a
+	rm -f $(I)/lib/$(SONAME).* $(I)/lib/$(SONAME) $(I)/lib/librouge.so $(I)/lib/pkgconfig/rouge.pc
+	rm -f $(I)/share/rouge/face.rsf $(I)/share/rouge/README.md
+	-rmdir $(I)/share/rouge 2>/dev/null
 
 clean:
 	rm -rf build build-*

@@ -11,6 +11,10 @@
 #define RS_APP_VERSION "0.1.0"
 #define RS_APP_DEFAULT_FACE "assets/face.rsf"
 
+// The face opened when none is named: assets/face.rsf in a source tree, else the installed copy next to
+// the program (<bin>/../share/rouge/face.rsf, what `make install` puts there). Fills buf.
+const char *rs_app_default_face(char *buf, size_t n);
+
 // Headless: load the face, apply --look / --strokes, render the view to cli->output (atomic PNG write).
 rs_result rs_app_render(const rs_cli *cli, rs_error *err);
 // The command line's view (every field explicit) as the public API's view.

@@ -12,7 +12,7 @@ static void usage(FILE *f)
             "\n"
             "usage:\n"
             "  rouge [view] [FACE.rsf] [options]        open the viewer (default face: assets/face.rsf)\n"
-            "  rouge render FACE.rsf -o OUT.png [options]  render headlessly (EGL) to a PNG\n"
+            "  rouge render [FACE.rsf] -o OUT.png [options]  render headlessly (EGL) to a PNG\n"
             "  rouge --help | --version\n"
             "\n"
             "options:\n");

@@ -1,8 +1,27 @@
 // render_cmd.c — `rouge render`: a headless EGL context, the face through the public API (rouge.h, as any
 // host uses it), --look, --strokes, --save-look, one frame written to a PNG.
+#define _POSIX_C_SOURCE 200809L
 #include "app.h"
 
 #include "rouge.h"
+
+#include <string.h>
+#include <unistd.h>
+
+const char *rs_app_default_face(char *buf, size_t n)
+{
+    snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
+    if (access(buf, R_OK) == 0) return buf;
+    char exe[512];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0) return buf;
+    exe[len] = 0;
+    char *slash = strrchr(exe, '/');
+    if (slash) *slash = 0;
+    snprintf(buf, n, "%s/../share/rouge/face.rsf", exe);
+    if (access(buf, R_OK) != 0) snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
+    return buf;
+}
 
 rouge_view rs_app_public_view(const rs_view *v)
 {
@@ -55,7 +74,6 @@ static rouge_result paint(const rs_cli *cli, rouge_face *face, rouge_error *e)
 
 rs_result rs_app_render(const rs_cli *cli, rs_error *err)
 {
-    if (!cli->face) return rs_fail(err, RS_ERR_ARG, "render: no face file given (usage: rouge render FACE.rsf -o OUT.png)");
     if (!cli->output) return rs_fail(err, RS_ERR_ARG, "render: no output given (-o OUT.png)");
     if (cli->save_look && !cli->look && !cli->strokes)
         return rs_fail(err, RS_ERR_ARG, "--save-look needs --look or --strokes to save");
@@ -65,7 +83,9 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
     rouge_error e = {0};
     rouge_face *face = NULL;
     rouge_view view = rs_app_public_view(&cli->view);
-    rouge_result r = rouge_face_create(&(rouge_face_desc){.path = cli->face, .view = &view}, &face, &e);
+    char def[600];
+    const char *path = cli->face ? cli->face : rs_app_default_face(def, sizeof def);
+    rouge_result r = rouge_face_create(&(rouge_face_desc){.path = path, .view = &view}, &face, &e);
     if (!r) r = paint(cli, face, &e);
     if (!r) r = rouge_face_render(face, &e);
     if (!r) r = rouge_face_write_png(face, cli->output, &e);

@@ -825,7 +825,8 @@ static rs_result bench_orbit(vw_viewer *v, int n, rs_error *err)
 static rs_result run(vw_viewer *v, rs_error *err)
 {
     const rs_cli *c = v->cli;
-    rs_result r = load_start(v, c->face ? c->face : RS_APP_DEFAULT_FACE, err);
+    char def[600];
+    rs_result r = load_start(v, c->face ? c->face : rs_app_default_face(def, sizeof def), err);
     if (r) return r;
     // Loading screen until the face is there.
     while (!v->ren) {
