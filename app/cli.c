@@ -20,11 +20,11 @@ static const char *const mode_names[RS_MODE_COUNT] = {"full", "albedo", "diffuse
 
 static const opt opts[] = {
     {"-o", OPT_PATH, "PNG", "output image (render); written atomically", 0, 0},
-    {"--size", OPT_SIZE, "WxH", "image size in pixels (default 512x512; 16..8192)", 16, 8192},
+    {"--size", OPT_SIZE, "WxH", "image size in pixels (default 512x512; 16..8192)", 16, RS_VIEW_MAX_SIZE_PX},
     {"--yaw", OPT_FLOAT, "DEG", "camera yaw around the face (0 = frontal, + = towards the subject's left)", -360, 360},
     {"--pitch", OPT_FLOAT, "DEG", "camera pitch (+ = from above)", -89, 89},
     {"--zoom", OPT_FLOAT, "Z", "1 = face fills the view; 2 = twice as close", 0.1f, 20},
-    {"--fov", OPT_FLOAT, "DEG", "vertical field of view (default 30)", 5, 120},
+    {"--fov", OPT_FLOAT, "DEG", "vertical field of view (default 30; 1..150)", RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG},
     {"--light-yaw", OPT_FLOAT, "DEG", "key light direction, yaw", -360, 360},
     {"--light-pitch", OPT_FLOAT, "DEG", "key light direction, pitch (+ = from above)", -90, 90},
     {"--light-color", OPT_RGB, "R,G,B", "key light colour, linear 0..10", 0, 10},
@@ -105,12 +105,18 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     const char *n = o->name;
     if (o->kind == OPT_ENUM) return parse_enum(n, v, c, err);
     if (o->kind == OPT_SIZE) {
-        int wd, ht;
-        char x, extra;
-        if (sscanf(v, "%d%c%d%c", &wd, &x, &ht, &extra) != 3 || (x != 'x' && x != 'X') || wd < o->lo || ht < o->lo ||
-            wd > o->hi || ht > o->hi)
+        // Digits only, each side at most 5 of them: sscanf's %d wraps 4294967312 to 16.
+        long wd = 0, ht = 0;
+        const char *p = v;
+        int nw = 0, nh = 0;
+        for (; *p >= '0' && *p <= '9' && nw < 6; p++, nw++) wd = wd * 10 + (*p - '0');
+        bool sep = *p == 'x' || *p == 'X';
+        if (sep) p++;
+        for (; *p >= '0' && *p <= '9' && nh < 6; p++, nh++) ht = ht * 10 + (*p - '0');
+        if (!sep || *p || nw == 0 || nh == 0 || nw > 5 || nh > 5 || wd < o->lo || ht < o->lo || wd > o->hi ||
+            ht > o->hi)
             return rs_fail(err, RS_ERR_ARG, "--size: expected WxH with 16..8192 pixels each, got '%s'", v);
-        w->width = wd, w->height = ht;
+        w->width = (int)wd, w->height = (int)ht;
         c->size_set = true;
         return RS_OK;
     }
@@ -156,6 +162,7 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
 rs_result rs_cli_parse(int argc, char **argv, bool allow_output, rs_cli *out, rs_error *err)
 {
     rs_cli c = {.view = rs_view_defaults()};
+    bool seen[RS_COUNT_OF(opts)] = {0};
     for (int i = 0; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
@@ -171,6 +178,9 @@ rs_result rs_cli_parse(int argc, char **argv, bool allow_output, rs_cli *out, rs
         for (size_t k = 0; k < RS_COUNT_OF(opts); k++)
             if (!strcmp(a, opts[k].name)) o = &opts[k];
         if (!o) return rs_fail(err, RS_ERR_ARG, "unknown option '%s' (see --help)", a);
+        // A second -o (or any option) silently winning hides a typo; say so instead.
+        if (seen[o - opts]) return rs_fail(err, RS_ERR_ARG, "%s given twice", a);
+        seen[o - opts] = true;
         if (!strcmp(a, "-o") && !allow_output) return rs_fail(err, RS_ERR_ARG, "-o is only for 'rouge render'");
         const char *v = NULL;
         if (o->kind != OPT_FLAG) {

@@ -6,6 +6,7 @@
 #include "rouge.h"
 
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 const char *rs_app_default_face(char *buf, size_t n)
@@ -68,8 +69,14 @@ static rouge_result paint(const rs_cli *cli, rouge_face *face, rouge_error *e)
         if (!cli->view_set[3]) v.fov_deg = cam.fov_deg;
         if (!r) r = rouge_face_set_view(face, &v, e);
     }
-    if (!r && cli->save_look) r = rouge_face_save_look(face, cli->save_look, e);
     return r;
+}
+
+// True when `a` and `b` name the same existing file (hard links and ./x vs x included).
+static bool same_file(const char *a, const char *b)
+{
+    struct stat sa, sb;
+    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
 }
 
 rs_result rs_app_render(const rs_cli *cli, rs_error *err)
@@ -77,17 +84,27 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
     if (!cli->output) return rs_fail(err, RS_ERR_ARG, "render: no output given (-o OUT.png)");
     if (cli->save_look && !cli->look && !cli->strokes)
         return rs_fail(err, RS_ERR_ARG, "--save-look needs --look or --strokes to save");
+    char def[600];
+    const char *path = cli->face ? cli->face : rs_app_default_face(def, sizeof def);
+    const char *inputs[] = {path, cli->look, cli->strokes};
+    for (size_t i = 0; i < RS_COUNT_OF(inputs); i++)
+        if (same_file(cli->output, inputs[i]))
+            return rs_fail(err, RS_ERR_ARG, "-o %s is an input of this render; refusing to overwrite it", cli->output);
+    if (same_file(cli->save_look, path) || same_file(cli->save_look, cli->strokes))
+        return rs_fail(err, RS_ERR_ARG, "--save-look %s is an input of this render; refusing to overwrite it",
+                       cli->save_look);
     rs_gl_context *gl = NULL;
     rs_result rr = rs_gl_create(&(rs_gl_desc){0}, &gl, err);
     if (rr) return rr;
     rouge_error e = {0};
     rouge_face *face = NULL;
     rouge_view view = rs_app_public_view(&cli->view);
-    char def[600];
-    const char *path = cli->face ? cli->face : rs_app_default_face(def, sizeof def);
     rouge_result r = rouge_face_create(&(rouge_face_desc){.path = path, .view = &view}, &face, &e);
     if (!r) r = paint(cli, face, &e);
     if (!r) r = rouge_face_render(face, &e);
+    // The look is saved only once the render it belongs to has succeeded, and before the PNG, so a look
+    // that cannot be written leaves no picture claiming it was.
+    if (!r && cli->save_look) r = rouge_face_save_look(face, cli->save_look, &e);
     if (!r) r = rouge_face_write_png(face, cli->output, &e);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);

@@ -46,6 +46,36 @@ expect cli_unwritable_output 1 "cannot write" "$rouge" render "$face" -o "$tmp/n
 mkfifo "$tmp/fifo"
 expect cli_fifo_as_output 1 "not a regular file" "$rouge" render "$face" -o "$tmp/fifo" --size 32x32 --max-splats 2000
 if [ -p "$tmp/fifo" ]; then echo "ok - cli_fifo_output_is_left_alone"; else echo "FAIL - cli_fifo_output_is_left_alone: replaced"; fi
+# A FIFO as any input must be refused at once, not block in open() waiting for a writer (timeout turns a
+# hang into exit 124, a failure).
+for c in "face|$rouge render $tmp/fifo -o $tmp/h.png" \
+    "look|$rouge render $face -o $tmp/h.png --size 32x32 --max-splats 2000 --look $tmp/fifo" \
+    "strokes|$rouge render $face -o $tmp/h.png --size 32x32 --max-splats 2000 --strokes $tmp/fifo" \
+    "pack_ply|$build/rouge-pack $tmp/fifo -o $tmp/h.rsf" \
+    "pack_texture|$build/rouge-pack tests/fixtures/ply/mesh_st.ply --texture $tmp/fifo -o $tmp/h.rsf" \
+    "imgdiff|$build/rouge-imgdiff $tmp/fifo tests/fixtures/image/a_8x8.png"; do
+    # shellcheck disable=SC2086
+    expect "cli_fifo_as_input_${c%%|*}" "$( [ "${c%%|*}" = imgdiff ] && echo 2 || echo 1 )" "not a regular file" \
+        timeout 20 ${c#*|}
+done
+no_file cli_fifo_input_leaves_no_output "$tmp/h.png"
+# Integer wrap: sscanf's %d once read 4294967312 as 16.
+expect cli_size_does_not_wrap 2 "--size: expected WxH" "$rouge" render "$face" -o "$tmp/i.png" --size 4294967312x16
+no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
+expect cli_second_output_refused 2 "-o given twice" "$rouge" render "$face" -o "$tmp/j.png" -o "$tmp/k.png"
+cp tests/fixtures/strokes/lips.strokes "$tmp/in.strokes"
+expect cli_output_equal_to_input_refused 2 "is an input of this render" \
+    "$rouge" render "$face" --strokes "$tmp/in.strokes" -o "$tmp/./in.strokes"
+if cmp -s tests/fixtures/strokes/lips.strokes "$tmp/in.strokes"; then echo "ok - cli_output_equal_to_input_keeps_the_input"
+else echo "FAIL - cli_output_equal_to_input_keeps_the_input: the stroke file was overwritten"; fi
+# A stroke file asking for what the renderer refuses is stopped where it is parsed (file and line named),
+# and the failed render leaves neither a saved look nor a PNG behind.
+sed 's/fov=[0-9.]*/fov=179/' tests/fixtures/strokes/lips.strokes >"$tmp/wide.strokes"
+expect cli_stroke_view_limit_names_file_and_line 1 "wide.strokes: line [0-9]*: view: fov: 179 not in" \
+    "$rouge" render "$face" --size 32x32 --max-splats 2000 --strokes "$tmp/wide.strokes" \
+    --save-look "$tmp/wide.look" -o "$tmp/wide.png"
+no_file cli_failed_render_saves_no_look "$tmp/wide.look"
+no_file cli_failed_render_writes_no_png "$tmp/wide.png"
 # No GLES 3: point glvnd at no EGL vendor at all.
 expect cli_no_gles3_is_one_clear_line 1 "no GLES 3 context" \
     env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$rouge" render "$face" -o "$tmp/f.png" --size 32x32

@@ -61,7 +61,8 @@ void *rs_alloc_array(size_t count, size_t elem_size)
 
 rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, size_t *out_len, rs_error *err)
 {
-    int fd = open(path, O_RDONLY);
+    // O_NONBLOCK: opening a FIFO for reading blocks until a writer appears; the type check below refuses it.
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
     struct stat st;
     if (fstat(fd, &st) != 0) {

@@ -51,6 +51,12 @@ rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, r
 // Monotonic clock in seconds, for benches and adaptive LOD (never for test assertions).
 double rs_time_now(void);
 
+// One limit per quantity, shared by the CLI, the file parsers and the renderer, so a file cannot ask for
+// what the command line refuses (a stroke file's view once allowed a 16384^2 frame and a 179 degree fov).
+#define RS_VIEW_MAX_SIZE_PX 8192  // frame side in pixels
+#define RS_VIEW_FOV_MIN_DEG 1.0f  // vertical field of view
+#define RS_VIEW_FOV_MAX_DEG 150.0f
+
 #define RS_COUNT_OF(a) (sizeof(a) / sizeof((a)[0]))
 #define RS_MIN(a, b) ((a) < (b) ? (a) : (b))
 #define RS_MAX(a, b) ((a) > (b) ? (a) : (b))

@@ -46,8 +46,9 @@ static rs_result check_view(const rs_strokes_view *v, rs_error *err)
         return rs_fail(err, RS_ERR_FORMAT, "view: pitch: %g not in [-90, 90]", v->pitch_deg);
     if (!in_range(v->zoom, 1e-3f, 100.0f))
         return rs_fail(err, RS_ERR_FORMAT, "view: zoom: %g not in [0.001, 100]", v->zoom);
-    if (!in_range(v->fov_deg, 1.0f, 179.0f))
-        return rs_fail(err, RS_ERR_FORMAT, "view: fov: %g not in [1, 179]", v->fov_deg);
+    if (!in_range(v->fov_deg, RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG))
+        return rs_fail(err, RS_ERR_FORMAT, "view: fov: %g not in [%g, %g]", v->fov_deg, RS_VIEW_FOV_MIN_DEG,
+                       RS_VIEW_FOV_MAX_DEG);
     if (v->width_px < 1 || v->width_px > RS_STROKES_MAX_SIZE_PX || v->height_px < 1 ||
         v->height_px > RS_STROKES_MAX_SIZE_PX)
         return rs_fail(err, RS_ERR_FORMAT, "view: size: %ux%u not in 1..%d", v->width_px, v->height_px,

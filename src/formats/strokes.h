@@ -24,7 +24,7 @@
 #define RS_STROKES_MAX_STROKES 4096
 #define RS_STROKES_MAX_SAMPLES (1u << 20)  // over all strokes
 #define RS_STROKES_MAX_COORD 1.0e5f        // |x|, |y| in pixels
-#define RS_STROKES_MAX_SIZE_PX 16384
+#define RS_STROKES_MAX_SIZE_PX RS_VIEW_MAX_SIZE_PX
 
 // The camera the samples' pixel coordinates refer to. yaw/pitch in degrees about the face frame
 // (0, 0 = looking at the face from hdr.forward), zoom as the app's camera defines it (1 = the face

@@ -566,8 +566,9 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
         return rs_fail(err, RS_ERR_ARG, "render: view size %dx%d outside 1..%d", view ? view->width : 0,
                        view ? view->height : 0, RS_MIN(r->caps.max_texture_size, RS_IMAGE_MAX_DIM));
     if ((unsigned)view->mode >= RS_MODE_COUNT) return rs_fail(err, RS_ERR_ARG, "render: unknown mode %d", view->mode);
-    if (!(view->fov_deg >= 0 && view->fov_deg < 170))
-        return rs_fail(err, RS_ERR_ARG, "render: field of view %g outside 0..170 degrees", view->fov_deg);
+    if (!(view->fov_deg >= RS_VIEW_FOV_MIN_DEG && view->fov_deg <= RS_VIEW_FOV_MAX_DEG))
+        return rs_fail(err, RS_ERR_ARG, "render: field of view %g outside %g..%g degrees", view->fov_deg,
+                       RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG);
     const float nums[] = {view->yaw_deg, view->pitch_deg, view->zoom, view->pan[0], view->pan[1], view->exposure,
                           view->ambient, view->rho_s_scale, view->key.yaw_deg, view->key.pitch_deg,
                           view->key.intensity, view->fill.yaw_deg, view->fill.pitch_deg, view->fill.intensity};
