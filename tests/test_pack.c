@@ -611,6 +611,31 @@ static void test_degenerate_clouds_convert_without_crashing(void)
     }
 }
 
+// NaN, inf and 1e300 normals in a PLY must be re-estimated, not clamped into a finite garbage direction
+// (to_float once made every one of them (-0.58, -0.58, -0.58)).
+static void test_nonfinite_input_normals_are_reestimated(void)
+{
+    rs_ply_mesh *m = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_ply_load("tests/fixtures/bad/ply_nonfinite_normals.ply", &m, &err) == RS_OK, "%s", err.msg);
+    rs_splat_cloud *c = NULL;
+    rs_pack_report rep;
+    rs_result r = rs_pack_convert(m, NULL, &c, &rep, &err);
+    rs_ply_destroy(m);
+    RS_REQUIRE(r == RS_OK, "%s", err.msg);
+    RS_CHECK(rep.normals_replaced == 80, "%u normals replaced, wanted the 80 bad ones", rep.normals_replaced);
+    float worst = 1;
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        rs_splat s;
+        rs_splat_get(c, i, &s);
+        // Points on a sphere around the origin: the normal is the (normalised) position.
+        float len = sqrtf(dot3(s.pos, s.pos)), radial[3] = {s.pos[0] / len, s.pos[1] / len, s.pos[2] / len};
+        worst = fminf(worst, dot3(s.normal, radial));
+    }
+    RS_CHECK(worst > 0.9f, "worst normal . radial = %.3f", worst);
+    rs_splat_destroy(c);
+}
+
 static void test_convert_rejects_bad_inputs_with_clear_errors(void)
 {
     float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}};
@@ -736,6 +761,7 @@ int main(int argc, char **argv)
     RS_RUN(test_knn_matches_brute_force);
     RS_RUN(test_knn_of_identical_points_is_fast_and_zero);
     RS_RUN(test_normals_on_sphere_point_outward);
+    RS_RUN(test_nonfinite_input_normals_are_reestimated);
     RS_RUN(test_normals_on_demosthenes_agree_with_given);
     RS_RUN(test_radius_matches_grid_spacing);
     RS_RUN(test_lod_prefix_is_spatially_uniform);

@@ -191,7 +191,11 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
                rep->duplicates_dropped ? " (duplicates dropped)" : "");
     if (rep->duplicates_dropped) printf("  duplicates    %u points at the same position dropped\n", rep->duplicates_dropped);
     printf("  splats        %u%s\n", rep->splats, rep->sampled_mesh ? " (area-uniform samples)" : "");
-    printf("  normals       %s\n", rep->normals_estimated ? "estimated (16-NN PCA, MST orientation)" : "from the input");
+    if (rep->normals_replaced)
+        printf("  normals       from the input; %u zero or not finite, re-estimated (16-NN PCA)\n",
+               rep->normals_replaced);
+    else
+        printf("  normals       %s\n", rep->normals_estimated ? "estimated (16-NN PCA, MST orientation)" : "from the input");
     printf("  colour        %s\n", rep->colour_default ? "none in the input: light warm grey (sRGB 200 178 160)"
                                                         : (o->maps[0] ? "from the texture" : "from the input"));
     if (o->texture_hint[0])

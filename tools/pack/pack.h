@@ -220,6 +220,7 @@ typedef struct rs_pack_report {
     uint32_t duplicates_dropped;  // points at the same position as another
     uint32_t splats;
     bool sampled_mesh, normals_estimated, colour_default, mm_estimated;
+    uint32_t normals_replaced;  // input normals that were zero or not finite, re-estimated (0: all usable)
     uint32_t regions_given;       // splats whose region came from the input (map or PLY property)
     rs_pack_face face;
     float specular_mean[RS_SPLAT_MAX_REGIONS];  // mean specular-map value per region, NAN without a map

@@ -281,6 +281,7 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
                 if (!usable_normal(p.normal[i]))
                     for (int a = 0; a < 3; a++) p.normal[i][a] = agree >= 0 ? est[i][a] : -est[i][a];
             free(est);
+            rep->normals_replaced = bad_normals;
         }
         rep->normals_estimated = true;
         step_end(&c);

@@ -442,7 +442,9 @@ static rs_result commit_vertex(ply_reader *r, uint32_t i, const double *v)
         m->pos[i][k] = (float)c;
     }
     if (m->normal)
-        for (int k = 0; k < 3; k++) m->normal[i][k] = to_float(v[ROLE_NX + k]);
+        // A normal that is not a finite float (NaN, inf, 1e300) becomes NaN: the converter then sees it as
+        // unusable and re-estimates it, instead of trusting a clamped (-FLT_MAX, ...) direction.
+        for (int k = 0; k < 3; k++) m->normal[i][k] = fabs(v[ROLE_NX + k]) <= FLT_MAX ? (float)v[ROLE_NX + k] : NAN;
     if (m->rgb)
         for (int k = 0; k < 3; k++) m->rgb[i][k] = to_byte(v[ROLE_R + k], r->role_type[ROLE_R + k]);
     if (m->uv)
