@@ -76,6 +76,12 @@ expect cli_stroke_view_limit_names_file_and_line 1 "wide.strokes: line [0-9]*: v
     --save-look "$tmp/wide.look" -o "$tmp/wide.png"
 no_file cli_failed_render_saves_no_look "$tmp/wide.look"
 no_file cli_failed_render_writes_no_png "$tmp/wide.png"
+# Terminal injection: a look whose keyword is an escape sequence (clear screen, retitle) is quoted escaped.
+printf 'rouge-look 1\n\033[2J\033]0;pwned\007 x\n' >"$tmp/inject.look"
+expect cli_error_quotes_file_text_escaped 1 'unknown keyword .\\x1b\[2J' \
+    "$rouge" render "$face" --size 32x32 --max-splats 2000 --look "$tmp/inject.look" -o "$tmp/l.png"
+if LC_ALL=C grep -q "$(printf '\033')" "$tmp/err"; then echo "FAIL - cli_error_has_no_escape_byte: ESC reached stderr"
+else echo "ok - cli_error_has_no_escape_byte"; fi
 # No GLES 3: point glvnd at no EGL vendor at all.
 expect cli_no_gles3_is_one_clear_line 1 "no GLES 3 context" \
     env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$rouge" render "$face" -o "$tmp/f.png" --size 32x32

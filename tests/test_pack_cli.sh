@@ -85,3 +85,18 @@ expect pack_info_truncated 1 "trunc.rsf" "$pack" --info "$tmp/trunc.rsf"
 expect pack_info_missing 1 "cannot open" "$pack" --info "$tmp/none.rsf"
 expect pack_info_with_input 2 "--info" "$pack" --info "$tmp/g.rsf" "$fx/points_le.ply"
 exit 0
+
+# A PLY whose comment is Latin-1 and carries a bidi override converts (the note is made valid, terminal-safe
+# UTF-8), and --info prints it escaped: no raw override reaches the terminal.
+if "$pack" tests/fixtures/bad/ply_latin1_bidi_comment.ply -o "$tmp/latin1.rsf" -q 2>"$tmp/latin1.err"; then
+    "$pack" --info "$tmp/latin1.rsf" >"$tmp/latin1.info" 2>&1
+    if ! grep -q 'caf\\xe9 by \\u{202e}evil' "$tmp/latin1.info"; then
+        echo "FAIL - pack_latin1_comment_kept_escaped: --info shows: $(grep -A1 notes "$tmp/latin1.info" | tail -1)"
+    elif LC_ALL=C grep -q "$(printf '\342\200\256')" "$tmp/latin1.info"; then
+        echo "FAIL - pack_latin1_comment_kept_escaped: a raw U+202E reached the listing"
+    else
+        echo "ok - pack_latin1_comment_kept_escaped"
+    fi
+else
+    echo "FAIL - pack_latin1_comment_kept_escaped: refused: $(head -c 300 "$tmp/latin1.err")"
+fi

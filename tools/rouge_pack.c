@@ -147,13 +147,18 @@ static int info(const char *path, const char *preview)
         printf("    %2u  %-10s m %.4f  rho_s %.4f  %9u splats (%5.2f%%)\n", i, h->regions[i].name, h->regions[i].m,
                h->regions[i].rho_s, c->region_counts[i], 100.0 * c->region_counts[i] / h->count);
     printf("  notes\n");
+    // Notes come from the file: printed terminal-safe (no escape sequences, no bidi overrides).
+    size_t cap = 8 * strlen(h->notes) + 1;
+    char *line = malloc(cap);
     const char *s = h->notes;
-    while (*s) {
+    while (line && *s) {
         const char *e = strchr(s, '\n');
-        int len = e ? (int)(e - s) : (int)strlen(s);
-        printf("    %.*s\n", len, s);
+        size_t len = e ? (size_t)(e - s) : strlen(s);
+        rs_text_sanitize(line, cap, s, len);
+        printf("    %s\n", line);
         s += len + (e ? 1 : 0);
     }
+    free(line);
     int rc = 0;
     if (preview) {
         rs_image img = {0};

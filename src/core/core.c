@@ -15,13 +15,68 @@
 rs_result rs_fail(rs_error *err, rs_result code, const char *fmt, ...)
 {
     if (err) {
+        char raw[sizeof err->msg];
         va_list ap;
         va_start(ap, fmt);
-        vsnprintf(err->msg, sizeof err->msg, fmt, ap);
+        vsnprintf(raw, sizeof raw, fmt, ap);
         va_end(ap);
+        rs_text_sanitize(err->msg, sizeof err->msg, raw, strlen(raw));
         err->code = code;
     }
     return code;
+}
+
+// Length of the valid UTF-8 sequence at s (1..4), or 0 when it is not one (overlong, surrogate, cut).
+static size_t utf8_seq(const unsigned char *s, size_t len, uint32_t *cp)
+{
+    unsigned char c = s[0];
+    size_t n = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c <= 0xDF ? 2 : 0;
+    if (c >= 0xF5 || n == 0 || n > len) return 0;
+    uint32_t v = c & (0xFF >> (n + 1));
+    for (size_t i = 1; i < n; i++) {
+        if ((s[i] & 0xC0) != 0x80) return 0;
+        v = v << 6 | (s[i] & 0x3F);
+    }
+    static const uint32_t min[5] = {0, 0, 0x80, 0x800, 0x10000};
+    if (v < min[n] || v > 0x10FFFF || (v >= 0xD800 && v <= 0xDFFF)) return 0;
+    *cp = v;
+    return n;
+}
+
+static bool unsafe_codepoint(uint32_t cp)
+{
+    return (cp >= 0x80 && cp <= 0x9F) || cp == 0x200E || cp == 0x200F || (cp >= 0x202A && cp <= 0x202E) ||
+           (cp >= 0x2066 && cp <= 0x2069);
+}
+
+size_t rs_text_sanitize(char *dst, size_t cap, const char *src, size_t len)
+{
+    if (cap == 0) return 0;
+    const unsigned char *s = (const unsigned char *)src;
+    size_t o = 0;
+    for (size_t i = 0; i < len && s[i];) {
+        char esc[16];
+        size_t n = 1, w;
+        uint32_t cp = s[i];
+        if (s[i] < 0x80) {
+            if (s[i] < 0x20 || s[i] == 0x7F) w = (size_t)snprintf(esc, sizeof esc, "\\x%02x", s[i]);
+            else esc[0] = (char)s[i], w = 1;
+        } else if ((n = utf8_seq(s + i, len - i, &cp)) == 0) {
+            n = 1;
+            w = (size_t)snprintf(esc, sizeof esc, "\\x%02x", s[i]);
+        } else if (unsafe_codepoint(cp)) {
+            w = (size_t)snprintf(esc, sizeof esc, "\\u{%04x}", cp);
+        } else {
+            memcpy(esc, s + i, n);
+            w = n;
+        }
+        if (o + w >= cap) break;
+        memcpy(dst + o, esc, w);
+        o += w;
+        i += n;
+    }
+    dst[o] = 0;
+    return o;
 }
 
 const char *rs_result_name(rs_result r)

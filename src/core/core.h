@@ -33,9 +33,17 @@ typedef struct rs_error {
 } rs_error;
 
 // Fills err (if non-NULL) and returns code, so callers can `return rs_fail(err, RS_ERR_IO, "...", ...)`.
+// The message is made terminal-safe (rs_text_sanitize): messages quote file content.
 rs_result rs_fail(rs_error *err, rs_result code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 const char *rs_result_name(rs_result r);
+
+// Copies `src` (len bytes) into dst (cap bytes, always NUL-terminated, cut at a character boundary) so
+// that a terminal shows it as text: control bytes (C0, DEL), C1 controls, bidirectional overrides and
+// isolates (U+202A-202E, U+2066-2069, U+200E/F) and bytes that are not UTF-8 become \xNN or \u{XXXX}.
+// File content quoted in messages and listings goes through it, so a file cannot clear or retitle the
+// terminal or reorder what the user reads. Returns the length written.
+size_t rs_text_sanitize(char *dst, size_t cap, const char *src, size_t len);
 
 // Overflow-checked arithmetic: false on overflow, *out untouched.
 bool rs_size_mul(size_t a, size_t b, size_t *out);

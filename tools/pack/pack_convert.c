@@ -156,17 +156,23 @@ static rs_result drop_duplicates(rs_pack_points *p, uint32_t *dropped, rs_error 
     return r;
 }
 
-// Header notes: the input's PLY comments (CC-BY attribution) then the caller's provenance line, cut at
-// a UTF-8 character boundary if too long.
+// Header notes: the input's PLY comments (CC-BY attribution) then the caller's provenance line, each
+// line made valid, terminal-safe UTF-8 (a Latin-1 comment's bytes become \\xNN: the scan still converts
+// and its attribution survives), cut at a character boundary if too long.
 static void make_notes(char *dst, const char *comments, const char *extra)
 {
-    size_t cap = RS_SPLAT_MAX_NOTES - 1, n = 0;
-    const char *parts[3] = {comments ? comments : "", comments && comments[0] && extra && extra[0] ? "\n" : "",
-                            extra ? extra : ""};
-    for (int k = 0; k < 3; k++)
-        for (const char *s = parts[k]; *s && n < cap; s++) dst[n++] = *s;
-    while (n > 0 && n == cap && ((unsigned char)dst[n - 1] & 0xc0) == 0x80) n--;  // continuation bytes
-    if (n > 0 && n == cap && ((unsigned char)dst[n - 1] & 0xc0) == 0xc0) n--;      // a dangling lead byte
+    size_t cap = RS_SPLAT_MAX_NOTES, n = 0;
+    const char *parts[2] = {comments ? comments : "", extra ? extra : ""};
+    dst[0] = 0;
+    for (int k = 0; k < 2; k++) {
+        for (const char *s = parts[k]; *s && n + 1 < cap;) {
+            const char *e = strchr(s, '\n');
+            size_t len = e ? (size_t)(e - s) : strlen(s);
+            if (n > 0) dst[n++] = '\n';
+            n += rs_text_sanitize(dst + n, cap - n, s, len);
+            s += len + (e ? 1 : 0);
+        }
+    }
     dst[n] = 0;
 }
 

@@ -1,0 +1,54 @@
+// test_core.c — the core helpers (src/core/core.c): terminal-safe text for messages that quote files.
+#include "support/harness.h"
+
+#include <string.h>
+
+static const char *clean(const char *in, size_t cap)
+{
+    static char out[256];
+    rs_text_sanitize(out, cap, in, strlen(in));
+    return out;
+}
+
+static void test_sanitize_escapes_control_bytes(void)
+{
+    RS_CHECK(!strcmp(clean("a\033[2Jb\x7f\n", 256), "a\\x1b[2Jb\\x7f\\x0a"), "%s", clean("a\033[2Jb\x7f\n", 256));
+}
+
+static void test_sanitize_escapes_bidi_overrides_and_c1(void)
+{
+    const char *in = "x\xe2\x80\xaey\xe2\x81\xa6z\xc2\x9b";  // U+202E, U+2066, U+009B (CSI)
+    RS_CHECK(!strcmp(clean(in, 256), "x\\u{202e}y\\u{2066}z\\u{009b}"), "%s", clean(in, 256));
+}
+
+static void test_sanitize_keeps_text_and_escapes_invalid_utf8(void)
+{
+    RS_CHECK(!strcmp(clean("caf\xc3\xa9 \xe6\x97\xa5", 256), "caf\xc3\xa9 \xe6\x97\xa5"), "valid UTF-8 kept");
+    RS_CHECK(!strcmp(clean("caf\xe9!", 256), "caf\\xe9!"), "Latin-1: %s", clean("caf\xe9!", 256));
+    RS_CHECK(!strcmp(clean("\xc0\xaf", 256), "\\xc0\\xaf"), "overlong: %s", clean("\xc0\xaf", 256));
+}
+
+static void test_sanitize_cuts_whole_characters(void)
+{
+    // 6 bytes of room: "ab" then an escape of 4 would overflow, so it stops before it.
+    RS_CHECK(!strcmp(clean("ab\033cd", 6), "ab"), "%s", clean("ab\033cd", 6));
+    RS_CHECK(!strcmp(clean("a\xc3\xa9", 3), "a"), "%s", clean("a\xc3\xa9", 3));
+}
+
+static void test_errors_are_sanitised(void)
+{
+    rs_error err = {0};
+    rs_fail(&err, RS_ERR_FORMAT, "unknown keyword '%s'", "\033]0;pwned\007");
+    RS_CHECK(!strcmp(err.msg, "unknown keyword '\\x1b]0;pwned\\x07'"), "%s", err.msg);
+}
+
+int main(int argc, char **argv)
+{
+    rs_test_init(argc, argv);
+    RS_RUN(test_sanitize_escapes_control_bytes);
+    RS_RUN(test_sanitize_escapes_bidi_overrides_and_c1);
+    RS_RUN(test_sanitize_keeps_text_and_escapes_invalid_utf8);
+    RS_RUN(test_sanitize_cuts_whole_characters);
+    RS_RUN(test_errors_are_sanitised);
+    return rs_test_finish();
+}
