@@ -84,7 +84,6 @@ head -c 300 "$tmp/g.rsf" >"$tmp/trunc.rsf"
 expect pack_info_truncated 1 "trunc.rsf" "$pack" --info "$tmp/trunc.rsf"
 expect pack_info_missing 1 "cannot open" "$pack" --info "$tmp/none.rsf"
 expect pack_info_with_input 2 "--info" "$pack" --info "$tmp/g.rsf" "$fx/points_le.ply"
-exit 0
 
 # A PLY whose comment is Latin-1 and carries a bidi override converts (the note is made valid, terminal-safe
 # UTF-8), and --info prints it escaped: no raw override reaches the terminal.
@@ -100,3 +99,14 @@ if "$pack" tests/fixtures/bad/ply_latin1_bidi_comment.ply -o "$tmp/latin1.rsf" -
 else
     echo "FAIL - pack_latin1_comment_kept_escaped: refused: $(head -c 300 "$tmp/latin1.err")"
 fi
+
+# Degenerate scans through the whole conversion and the preview rasteriser (whose float-to-int casts
+# were undefined for inf/huge screen positions; `make asan` adds -fsanitize=float-cast-overflow).
+for f in ply_spread_1e20 ply_scaled_1e-38; do
+    "$pack" tests/fixtures/bad/$f.ply -o "$tmp/$f.rsf" --preview "$tmp/$f.png" -q >"$tmp/$f.out" 2>&1
+    rc=$?
+    if [ $rc -eq 0 ] && [ -s "$tmp/$f.png" ]; then echo "ok - pack_preview_degenerate_$f"
+    elif [ $rc -eq 1 ] && [ "$(wc -l <"$tmp/$f.out")" -eq 1 ]; then echo "ok - pack_preview_degenerate_$f"
+    else echo "FAIL - pack_preview_degenerate_$f: exit $rc: $(head -c 300 "$tmp/$f.out")"; fi
+done
+exit 0

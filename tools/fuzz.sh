@@ -39,7 +39,7 @@ if ! "$cc" -fsanitize=fuzzer,address,undefined "$probe.c" -o "$probe" 2>"$probe.
 fi
 
 # ---- build: the libraries with coverage + sanitizers (the project's Makefile, clang, own directory) ----
-san='-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer'
+san='-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer'
 say "building the libraries with $cc ($san) in $dir/lib"
 make --no-print-directory -s BUILD="$dir/lib" CC="$cc" OPT=-O1 \
     EXTRA_CFLAGS="-Wno-unknown-warning-option -fsanitize=fuzzer-no-link $san" \

@@ -32,7 +32,12 @@ static void draw_panel(const rs_splat_cloud *c, const view *v, float scale, cons
         if (facing <= 0) continue;  // back-facing: the renderer culls these too
         float sx = (dot3(s.pos, v->right) - mid[0]) * scale + w * 0.5f;
         float sy = h * 0.5f - (dot3(s.pos, v->up) - mid[1]) * scale;
-        float z = dot3(s.pos, v->toward), r = fmaxf(s.radius * scale, 0.71f);
+        // Degenerate scans (spread over 1e20, scaled to 1e-38) give inf/NaN or huge screen positions: skip
+        // what is not on the panel before any float-to-int conversion (which would be undefined), and cap
+        // the disk so one splat's cost stays bounded (a preview disk wider than 1/8 panel shows nothing).
+        float z = dot3(s.pos, v->toward), r = fminf(fmaxf(s.radius * scale, 0.71f), w / 8.0f);
+        if (!(isfinite(sx) && isfinite(sy) && isfinite(z) && r > 0)) continue;
+        if (sx + r < 0 || sx - r > w || sy + r < 0 || sy - r > h) continue;
         // Headlight shading so the shape reads; colours stay sRGB, this is a debugging view.
         float shade = 0.3f + 0.7f * facing;
         const uint8_t *base = regions ? region_rgb[s.region < RS_REGION_BUILTIN_COUNT ? s.region : 0] : s.rgb;
