@@ -3,7 +3,7 @@
 build=${1:-build}
 rouge="$build/rouge"
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+trap 'umount "$tmp/full" 2>/dev/null; rm -rf "$tmp"' EXIT
 face=assets/face.rsf
 
 # expect NAME WANT_RC PATTERN CMD... : runs CMD, checks exit code, one-line stderr matching PATTERN.
@@ -82,6 +82,24 @@ expect cli_error_quotes_file_text_escaped 1 'unknown keyword .\\x1b\[2J' \
     "$rouge" render "$face" --size 32x32 --max-splats 2000 --look "$tmp/inject.look" -o "$tmp/l.png"
 if LC_ALL=C grep -q "$(printf '\033')" "$tmp/err"; then echo "FAIL - cli_error_has_no_escape_byte: ESC reached stderr"
 else echo "ok - cli_error_has_no_escape_byte"; fi
+# A full disk: every writer says "No space left on device" and keeps the old file (a 64 kB tmpfs, filled).
+mkdir -p "$tmp/full"
+if mount -t tmpfs -o size=64k tmpfs "$tmp/full" 2>/dev/null; then
+    for f in o.png o.rsf o.look; do printf 'old %s' "$f" >"$tmp/full/$f"; done
+    dd if=/dev/zero of="$tmp/full/filler" bs=1k count=64 >/dev/null 2>&1
+    expect cli_full_disk_png 1 "No space left on device" "$rouge" render "$face" -o "$tmp/full/o.png" --size 128x128 --max-splats 2000
+    expect cli_full_disk_rsf 1 "No space left on device" "$build/rouge-pack" tests/fixtures/ply/points_le.ply -o "$tmp/full/o.rsf" -q
+    expect cli_full_disk_look 1 "No space left on device" "$rouge" render "$face" -o "$tmp/l.png" --size 32x32 --max-splats 2000 \
+        --strokes tests/fixtures/strokes/lips.strokes --save-look "$tmp/full/o.look"
+    kept=1
+    for f in o.png o.rsf o.look; do [ "$(cat "$tmp/full/$f")" = "old $f" ] || kept=0; done
+    left=$(ls "$tmp/full" | grep -c '\.tmp\.')
+    if [ $kept = 1 ] && [ "$left" = 0 ]; then echo "ok - cli_full_disk_keeps_old_files"
+    else echo "FAIL - cli_full_disk_keeps_old_files: old kept $kept, temp files $left"; fi
+    umount "$tmp/full"
+else
+    echo "skip - cli_full_disk: cannot mount a tmpfs here (needs root)"
+fi
 # No GLES 3: point glvnd at no EGL vendor at all.
 expect cli_no_gles3_is_one_clear_line 1 "no GLES 3 context" \
     env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent.json "$rouge" render "$face" -o "$tmp/f.png" --size 32x32

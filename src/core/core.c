@@ -1,9 +1,12 @@
 // core.c — see core.h.
-#define _POSIX_C_SOURCE 200809L
+// _GNU_SOURCE: O_TMPFILE (Linux); everything else used is POSIX.1-2008.
+#define _GNU_SOURCE
 #include "core/core.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -158,31 +161,95 @@ rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, 
     return RS_OK;
 }
 
-rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err)
+// Splits path into its directory ("." when none) and base name.
+static bool split_path(const char *path, char *dir, size_t cap, const char **base)
 {
-    // Only ever replace a regular file: renaming over /dev/null, a FIFO or a socket would destroy it.
-    struct stat st;
-    if (lstat(path, &st) == 0 && !S_ISREG(st.st_mode))
-        return rs_fail(err, RS_ERR_IO, "%s: cannot write: not a regular file", path);
-    char tmp[4096];
-    int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
-    if (n < 0 || (size_t)n >= sizeof tmp) return rs_fail(err, RS_ERR_ARG, "%s: path too long", path);
-    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (fd < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    const char *slash = strrchr(path, '/');
+    *base = slash ? slash + 1 : path;
+    int n = slash ? snprintf(dir, cap, "%.*s", (int)(slash - path > 0 ? slash - path : 1), path)
+                  : snprintf(dir, cap, ".");
+    return n > 0 && (size_t)n < cap;
+}
+
+// Removes "<base>.tmp.<pid>" files next to the target whose writer process is gone: what a save killed
+// mid-write (SIGKILL, power loss) left behind. Only our own pattern, only for this target.
+static void remove_stale_temps(const char *dir, const char *base)
+{
+    DIR *d = opendir(dir);
+    if (!d) return;
+    size_t bl = strlen(base);
+    struct dirent *e;
+    while ((e = readdir(d))) {
+        const char *n = e->d_name;
+        if (strncmp(n, base, bl) != 0 || strncmp(n + bl, ".tmp.", 5) != 0) continue;
+        char *endp;
+        long pid = strtol(n + bl + 5, &endp, 10);
+        if (*endp || pid <= 0 || (pid == (long)getpid())) continue;
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+        char full[4096];
+        if ((size_t)snprintf(full, sizeof full, "%s/%s", dir, n) < sizeof full) unlink(full);
+    }
+    closedir(d);
+}
+
+static bool write_all(int fd, const void *data, size_t len)
+{
     const unsigned char *p = data;
     size_t done = 0;
     while (done < len) {
         ssize_t w = write(fd, p + done, len - done);
         if (w < 0 && errno == EINTR) continue;
         if (w <= 0) {
-            int e = errno;
-            close(fd);
-            unlink(tmp);
-            return rs_fail(err, RS_ERR_IO, "%s: write failed: %s", path, strerror(e));
+            if (w == 0) errno = EIO;
+            return false;
         }
         done += (size_t)w;
     }
-    if (fsync(fd) != 0 || close(fd) != 0) {
+    return true;
+}
+
+rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err)
+{
+    // Only ever replace a regular file: renaming over /dev/null, a FIFO or a socket would destroy it.
+    struct stat st;
+    if (lstat(path, &st) == 0 && !S_ISREG(st.st_mode))
+        return rs_fail(err, RS_ERR_IO, "%s: cannot write: not a regular file", path);
+    char dir[4096], tmp[4096];
+    const char *base;
+    int n = snprintf(tmp, sizeof tmp, "%s.tmp.%ld", path, (long)getpid());
+    if (n < 0 || (size_t)n >= sizeof tmp || !split_path(path, dir, sizeof dir, &base))
+        return rs_fail(err, RS_ERR_ARG, "%s: path too long", path);
+    remove_stale_temps(dir, base);
+    // Where the filesystem has O_TMPFILE the data is written to an unnamed file, so a process killed
+    // while writing leaves nothing behind; it gets the temp name only once complete, just before the rename.
+    bool named = false;
+#ifdef O_TMPFILE
+    int fd = open(dir, O_TMPFILE | O_WRONLY | O_CLOEXEC, 0644);
+#else
+    int fd = -1;
+#endif
+    if (fd < 0) {
+        fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+        named = true;
+    }
+    if (fd < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    if (!write_all(fd, data, len) || fsync(fd) != 0) {
+        int e = errno;
+        close(fd);
+        if (named) unlink(tmp);
+        return rs_fail(err, RS_ERR_IO, "%s: write failed: %s", path, strerror(e));
+    }
+    if (!named) {
+        char proc[64];
+        snprintf(proc, sizeof proc, "/proc/self/fd/%d", fd);
+        unlink(tmp);  // a stale one of our own pid (pid reuse) would make linkat fail
+        if (linkat(AT_FDCWD, proc, AT_FDCWD, tmp, AT_SYMLINK_FOLLOW) != 0) {
+            int e = errno;
+            close(fd);
+            return rs_fail(err, RS_ERR_IO, "%s: cannot write: %s", path, strerror(e));
+        }
+    }
+    if (close(fd) != 0) {
         int e = errno;
         unlink(tmp);
         return rs_fail(err, RS_ERR_IO, "%s: write failed: %s", path, strerror(e));
@@ -191,6 +258,12 @@ rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, r
         int e = errno;
         unlink(tmp);
         return rs_fail(err, RS_ERR_IO, "%s: cannot replace: %s", path, strerror(e));
+    }
+    // The rename is durable only once the directory entry is on disk.
+    int dfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dfd >= 0) {
+        fsync(dfd);
+        close(dfd);
     }
     return RS_OK;
 }
