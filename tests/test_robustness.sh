@@ -100,6 +100,7 @@ rsf_count_past_end.rsf|count:|count larger than the file holds
 rsf_nan_bbox.rsf|bbox_min[0]:|NaN in the bounding box
 rsf_inverted_bbox.rsf|bbox_max[0]:|bbox max below min
 rsf_negative_radius.rsf|radius_min:|negative radius range
+rsf_radius_bomb.rsf|radius_max: 1e+07 is more than 4 times the bounding box|radius_max 1e7, every radius code 255 (a work bomb)
 rsf_inf_mm_per_unit.rsf|mm_per_unit:|infinite scale
 rsf_forward_not_unit.rsf|forward:|face frame not unit length
 rsf_negative_face_height.rsf|face_height:|negative face height

@@ -915,6 +915,30 @@ static void test_lod_count_picks_largest_fitting_prefix(void)
     free(s);
 }
 
+// The work bound: disks that together cover hundreds of times the model (a file of whole-model splats that
+// once took hours to shadow) are refused; a dense real-scan-like cloud passes.
+static void test_splat_area_beyond_the_work_bound_is_refused(void)
+{
+    enum { N = 2000 };
+    rs_splat *s = calloc(N, sizeof *s);
+    RS_REQUIRE(s, "oom");
+    rs_splat_header h;
+    memset(&h, 0, sizeof h);
+    h.face_height = 1.0f, h.lod_count = 1, h.lods[0] = N;
+    for (uint32_t i = 0; i < N; i++)
+        s[i] = (rs_splat){{(float)(i % 45) / 44.0f, (float)(i / 45) / 44.0f, 0.0f}, {0, 0, 1}, 0.5f, {200, 150, 130}, 0};
+    rs_splat_cloud *c = NULL;
+    rs_error err = {0};
+    RS_CHECK(rs_splat_create(s, N, &h, &c, &err) != RS_OK && strstr(err.msg, "radii: the splats cover"),
+             "2000 half-model disks: %s", c ? "accepted" : err.msg);
+    rs_splat_destroy(c);
+    c = NULL;
+    for (uint32_t i = 0; i < N; i++) s[i].radius = 0.03f;  // about the grid spacing: a surface sample
+    RS_CHECK(rs_splat_create(s, N, &h, &c, &err) == RS_OK, "%s", err.msg);
+    rs_splat_destroy(c);
+    free(s);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -925,6 +949,7 @@ int main(int argc, char **argv)
     RS_RUN(test_radius_round_trip_within_half_log_step);
     RS_RUN(test_colour_and_region_are_exact);
     RS_RUN(test_degenerate_clouds_get_a_valid_frame);
+    RS_RUN(test_splat_area_beyond_the_work_bound_is_refused);
     RS_RUN(test_create_rejects_bad_splats_naming_the_index);
     RS_RUN(test_create_rejects_bad_header_tables);
     RS_RUN(test_create_fills_zero_defaults_and_orthonormal_frame);

@@ -161,6 +161,14 @@ static rs_result check_bbox(const check_ctx *x, const rs_splat_header *h)
     return RS_OK;
 }
 
+// The bbox's largest extent (check_bbox has made sure it is finite and positive).
+static double bbox_extent(const rs_splat_header *h)
+{
+    double e = 0;
+    for (int a = 0; a < 3; a++) e = fmax(e, (double)h->bbox_max[a] - h->bbox_min[a]);
+    return e;
+}
+
 static rs_result check_radius(const check_ctx *x, const rs_splat_header *h)
 {
     float lo = h->radius_min, hi = h->radius_max;
@@ -172,6 +180,10 @@ static rs_result check_radius(const check_ctx *x, const rs_splat_header *h)
     if ((double)hi > (double)lo * RS_SPLAT_RADIUS_RATIO_MAX * (1.0 + 1e-5))
         return bad(x, RSF_OFF_RADIUS_MAX, "radius_max: %g is more than %g times radius_min %g", hi,
                    RS_SPLAT_RADIUS_RATIO_MAX, lo);
+    double e = bbox_extent(h);
+    if ((double)hi > RS_SPLAT_RADIUS_EXTENT_MAX * e * (1.0 + 1e-5))
+        return bad(x, RSF_OFF_RADIUS_MAX, "radius_max: %g is more than %g times the bounding box (%g)", hi,
+                   RS_SPLAT_RADIUS_EXTENT_MAX, e);
     return RS_OK;
 }
 
@@ -356,6 +368,7 @@ rs_result rs_splat_decode_all(rs_splat_cloud *c, const char *name, bool in_file,
     // 256 radii per file: a table keeps pow() out of the per-splat loop.
     for (uint32_t q = 0; q < 256; q++) radius_of[q] = decode_radius(h, q);
     uint32_t counts[RS_SPLAT_MAX_REGIONS] = {0};
+    double area = 0, extent = bbox_extent(h);
     for (uint32_t i = 0; i < h->count; i++) {
         const uint32_t *w = c->packed[i].w;
         uint32_t region = w[1] >> 24, flags = w[3] >> 24;
@@ -369,8 +382,13 @@ rs_result rs_splat_decode_all(rs_splat_cloud *c, const char *name, bool in_file,
         c->pos[i][2] = lo[2] + (float)(w[1] & 0xffffu) * step[2];
         rs_splat_decode_normal(w[2], c->normal[i]);
         c->radius[i] = radius_of[(w[1] >> 16) & 0xffu];
+        area += (double)c->radius[i] * c->radius[i];
         counts[region]++;
     }
+    area *= 3.14159265358979;
+    if (area > RS_SPLAT_AREA_MAX * extent * extent)
+        return bad(&x, payload_off, "radii: the splats cover %.3g times the bounding box's largest face (at most %g): "
+                   "not a surface scan, and too costly to draw", area / (extent * extent), RS_SPLAT_AREA_MAX);
     memcpy(c->region_counts, counts, sizeof counts);
     return RS_OK;
 }
@@ -498,7 +516,8 @@ static rs_result scan_splats(const rs_splat *s, uint32_t count, rs_splat_header 
     for (int a = 0; a < 3; a++) {
         // A flat or single-point cloud: the pad is arbitrary but must survive float rounding at |lo|.
         if (!(hi[a] > lo[a])) {
-            float pad = 0.5e-3f * fmaxf(fmaxf(extent, fabsf(lo[a])), 1.0f);
+            // At least the disk's radius, so the box holds the splats (and radius_max fits the bound below).
+            float pad = fmaxf(0.5e-3f * fmaxf(fmaxf(extent, fabsf(lo[a])), 1.0f), rmax);
             lo[a] -= pad;
             hi[a] += pad;
         }
@@ -507,6 +526,12 @@ static rs_result scan_splats(const rs_splat *s, uint32_t count, rs_splat_header 
                            who, a, lo[a], hi[a]);
         h->bbox_min[a] = lo[a];
         h->bbox_max[a] = hi[a];
+    }
+    // Radii beyond the work bound (RS_SPLAT_RADIUS_EXTENT_MAX) are no surface samples: clamp them.
+    double cap = RS_SPLAT_RADIUS_EXTENT_MAX * bbox_extent(h);
+    if (h->radius_max > cap) {
+        h->radius_max = (float)(0.5 * cap);
+        h->radius_min = fminf(h->radius_min, (float)(0.5 * cap / 2.0));
     }
     return RS_OK;
 }

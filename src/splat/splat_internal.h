@@ -37,6 +37,11 @@ enum {
 // Radii are log-quantized over [radius_min, radius_max]; a wider ratio would make the 8-bit steps coarse
 // (1e6 gives 5.6 % steps) and risk float overflow in the decode.
 #define RS_SPLAT_RADIUS_RATIO_MAX 1e6
+// Work bounds a valid file must keep, so no pass's cost can grow past what the view asks for: a splat's
+// radius is at most RADIUS_EXTENT_MAX times the bbox's largest extent E, and the splats' disks together
+// cover at most AREA_MAX * E^2 (real scans: 2-30; 20k whole-model disks once took hours to shadow).
+#define RS_SPLAT_RADIUS_EXTENT_MAX 4.0
+#define RS_SPLAT_AREA_MAX 256.0
 
 // Checks every header field except the payload. `in_file`: errors are RS_ERR_FORMAT and end with
 // "(byte N)" (loader), otherwise RS_ERR_ARG without offsets (create/save: the caller's header).
