@@ -681,6 +681,7 @@ rouge_result rouge_face_play_strokes(rouge_face *f, const char *path, rouge_erro
     rs_view saved = f->frame_view;
     bool had_frame = f->have_frame;
     rs_paint_set_recorder(f->paint, NULL, NULL);
+    double cover = 0;
     for (uint32_t i = 0; !r && i < doc->count; i++) {
         const rs_strokes_view *sv = &doc->strokes[i].view;
         f->view.yaw_deg = sv->yaw_deg, f->view.pitch_deg = sv->pitch_deg;
@@ -689,6 +690,15 @@ rouge_result rouge_face_play_strokes(rouge_face *f, const char *path, rouge_erro
         f->have_frame = true;
         rs_paint_result res;
         r = rs_paint_replay(f->paint, doc, i, sv->width_px, sv->height_px, &res, &e);
+        cover += res.cover;
+        if (!r && cover > RS_PAINT_MAX_REPLAY_COVER)
+            r = rs_fail(&e, RS_ERR_LIMIT, "strokes paint more than %.0f face areas by stroke %u",
+                        RS_PAINT_MAX_REPLAY_COVER, i);
+    }
+    if (r && doc && !strstr(e.msg, path)) {
+        // Name the file the bound was met in (the parser's own errors already do).
+        rs_error named = e;
+        rs_fail(&e, named.code, "%s: %s", path, named.msg);
     }
     if (f->rec) rs_paint_set_recorder(f->paint, f->rec, NULL);
     f->have_frame = had_frame;

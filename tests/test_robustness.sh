@@ -178,6 +178,7 @@ strokes_version_9.strokes|version '9'|version 9
 strokes_unknown_keyword.strokes|line 6:|unknown keyword inside a stroke
 strokes_nan_sample.strokes|'nan'|NaN pointer position
 strokes_huge_view.strokes|size:|view size 999999999x999999999
+strokes_work_bomb.strokes|paints more than 256 face areas|a 20000-sample zigzag with a wide brush (a work bomb: > 300 s before)
 strokes_unknown_cosmetic.strokes|glitter_bomb|unknown cosmetic preset
 strokes_bad_pressure.strokes|pressure:|pressure 7.5
 strokes_sample_outside_stroke.strokes|outside a stroke|sample before 'stroke'
@@ -200,6 +201,7 @@ look_nan_stamp.look|'nan'|NaN stamp position
 look_cosmetic_out_of_range.look|cosmetic index|stamp names cosmetic 7 of 1
 look_unknown_cosmetic.look|glitter_bomb|unknown cosmetic preset
 look_huge_radius.look|radius:|stamp radius 1e30
+look_work_bomb.look|stamps cover 1960 face areas|2000 stamps as wide as the face (a work bomb: 121 s before)
 look_negative_face_height.look|face:|face height -1
 EOF
 bad_input look_other_face "look file made on a face 19x smaller" 2 "another face" "$tmp/o.png" \

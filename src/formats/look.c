@@ -152,6 +152,16 @@ rs_result rs_look_parse(const void *data, size_t len, rs_look **out, rs_error *e
     if (r == RS_OK && !header) r = rs_fail(err, RS_ERR_FORMAT, "look: empty file (no 'rouge-look' line)");
     if (r == RS_OK && !p.have_face) r = rs_fail(err, RS_ERR_FORMAT, "look: missing the 'face' line");
     if (r == RS_OK && p.in_stroke) r = rs_fail(err, RS_ERR_FORMAT, "line %u: file ends inside a stroke", p.line);
+    if (r == RS_OK) {
+        double cover = 0;
+        for (uint32_t i = 0; i < lk->stamp_count; i++) {
+            double q = lk->stamps[i].radius / lk->face_height;
+            cover += q * q;
+        }
+        if (cover > RS_LOOK_MAX_COVER)
+            r = rs_fail(err, RS_ERR_LIMIT, "look: %u stamps cover %.0f face areas, more than the %.0f allowed",
+                        lk->stamp_count, cover, RS_LOOK_MAX_COVER);
+    }
     if (r != RS_OK) {
         rs_look_destroy(lk);
         return r;

@@ -24,6 +24,11 @@
 #define RS_LOOK_MAX_STAMPS (1u << 20)  // == the layer's log cap
 #define RS_LOOK_MAX_COSMETICS 4096
 #define RS_LOOK_MAX_COORD 1.0e6f
+// Work bound: the stamps' areas summed, in face-height^2 units (sum of (radius / face height)^2). A
+// stamp's cost grows with the splats under it, so this bounds a look's replay by the face, not by what
+// the file claims. A face painted over fully with the largest brush is ~3.3; 2000 stamps as wide as the
+// face (a 121 s replay) are ~2000.
+#define RS_LOOK_MAX_COVER 256.0
 
 typedef struct rs_look {
     float face_height;              // of the face it was painted on (model units)

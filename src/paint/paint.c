@@ -211,6 +211,7 @@ rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, u
     p->brush = (rs_paint_brush){st->cosmetic, st->brush.size_rel, st->brush.opacity, st->brush.pressure,
                                 st->brush.eraser, st->brush.mirror};
     rs_input_set_mode(&p->input, RS_INPUT_PAINT);
+    double q = rs_paint_radius(p) / rs_makeup_cloud(p->mk)->hdr.face_height;
     float sx = (float)frame_w_px / (float)st->view.width_px, sy = (float)frame_h_px / (float)st->view.height_px;
     rs_result r = RS_OK;
     // The live sequence was down (first sample), moves, up (last sample): feed exactly that.
@@ -224,6 +225,11 @@ rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, u
         r = rs_paint_feed(p, &ev, &one, err);
         merge(&res->dirty, one.dirty);
         res->stamps += one.stamps;
+        // Each stamp costs the splats under it: a long zigzag with a wide brush is bounded here, as it goes.
+        res->cover = res->stamps * q * q;
+        if (r == RS_OK && res->cover > RS_PAINT_MAX_REPLAY_COVER)
+            r = rs_fail(err, RS_ERR_LIMIT, "stroke %u paints more than %.0f face areas (%u stamps)", stroke,
+                        RS_PAINT_MAX_REPLAY_COVER, res->stamps);
         res->misses += one.misses;
         res->stroke_begin |= one.stroke_begin;
         res->stroke_end |= one.stroke_end;

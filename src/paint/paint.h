@@ -54,6 +54,7 @@ typedef struct rs_paint_result {
     float zoom, zoom_cx_px, zoom_cy_px;  // pinch factor (1 = none) and centre
     rs_makeup_range dirty;           // records to upload (union over everything this call did)
     uint32_t stamps, misses;         // stamps applied, stamps whose pixel hit background
+    double cover;                    // rs_paint_replay: stamps x (radius / face height)^2, its work
     bool stroke_begin, stroke_end, stroke_cancel;
 } rs_paint_result;
 
@@ -80,6 +81,9 @@ void rs_paint_set_recorder(rs_paint *p, rs_strokes *doc, const rs_strokes_view *
 // Replays one recorded stroke: sets the brush from it and feeds its samples as one pointer in paint
 // mode, coordinates scaled by (frame size / stroke view size). The caller has set the camera to
 // stroke->view first (the picker must see that view). The brush and mode are restored afterwards.
+// Work bound of a replay (files are untrusted): the stamps a replay makes, summed as face areas
+// (stamps x (brush radius / face height)^2), may not pass this; a stroke file's replays share it.
+#define RS_PAINT_MAX_REPLAY_COVER 256.0
 rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, uint32_t frame_w_px,
                           uint32_t frame_h_px, rs_paint_result *res, rs_error *err);
 
