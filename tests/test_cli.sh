@@ -62,6 +62,9 @@ no_file cli_fifo_input_leaves_no_output "$tmp/h.png"
 # Integer wrap: sscanf's %d once read 4294967312 as 16.
 expect cli_size_does_not_wrap 2 "--size: expected WxH" "$rouge" render "$face" -o "$tmp/i.png" --size 4294967312x16
 no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
+# Memory: the frame size is bounded by what its render targets cost, said in the error.
+expect cli_size_bounded_by_target_memory 1 "needs about 3.7 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
+no_file cli_size_memory_leaves_no_output "$tmp/m.png"
 expect cli_second_output_refused 2 "-o given twice" "$rouge" render "$face" -o "$tmp/j.png" -o "$tmp/k.png"
 cp tests/fixtures/strokes/lips.strokes "$tmp/in.strokes"
 expect cli_output_equal_to_input_refused 2 "is an input of this render" \

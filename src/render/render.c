@@ -498,9 +498,24 @@ static GLuint fbo_with(const GLuint *colour, int ncolour, GLuint depth)
     return fbo;
 }
 
+// Render targets of a w x h frame: depth, three attribute targets, diffuse, output, the reduced-resolution
+// diffusion levels (at most 4/3 of one accumulation target) and the ID buffer (R32UI + depth). llvmpipe keeps
+// all of it in CPU memory, so this is what a frame size costs the machine.
+static double target_estimate(int w, int h, bool float_rt)
+{
+    double px = (double)w * h, acc = float_rt ? 8 : 4;
+    return px * (4 + 4 * acc + 4 + acc * 4.0 / 3.0 + 8);
+}
+
 static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
 {
     if (r->tw == w && r->th == h) return RS_OK;
+    // Bounded by memory, not by side length alone: 8192^2 once peaked at 3.65 GB.
+    double need = target_estimate(w, h, r->float_rt);
+    if (need > RS_RENDER_MAX_TARGET_BYTES)
+        return rs_fail(err, RS_ERR_LIMIT, "render: %dx%d needs about %.1f GiB of render targets, more than the %.1f GiB "
+                       "allowed (use a smaller --size)", w, h, need / (1u << 30),
+                       (double)RS_RENDER_MAX_TARGET_BYTES / (1u << 30));
     release_targets(r);
     GLenum acc = r->float_rt ? GL_RGBA16F : GL_RGBA8;
     r->depth_tex = rs_render_texture(GL_DEPTH_COMPONENT32F, w, h);

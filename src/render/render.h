@@ -23,6 +23,9 @@
 #include "makeup/makeup.h"
 #include "splat/splat.h"
 
+// Largest render-target memory a frame may ask for (depth, attributes, diffusion, output, ID buffer).
+#define RS_RENDER_MAX_TARGET_BYTES (1536.0 * 1024 * 1024)
+
 typedef enum rs_render_mode {
     RS_MODE_FULL = 0,   // subsurface + specular (paper Fig. 7 right)
     RS_MODE_ALBEDO,     // no lighting (Fig. 7 left)
