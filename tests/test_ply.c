@@ -599,8 +599,9 @@ static void test_header_errors_name_the_problem_and_line(void)
 {
     expect_fail_str("", RS_ERR_FORMAT, "not a PLY file", "(line 1)");
     expect_fail_edit(ASCII_CLOUD, "ply\n", "PLY\n", RS_ERR_FORMAT, "not a PLY file", "(line 1)");
-    expect_fail_edit(ASCII_CLOUD, "comment test\n", "commentary test\n", RS_ERR_FORMAT,
-                     "unknown header keyword 'commentary'", "(line 3)");
+    // (Before the first element, free text is taken as a comment: test_lenient_inputs_load_with_a_warning.)
+    expect_fail_edit(ASCII_CLOUD, "property float y\n", "commentary test\n", RS_ERR_FORMAT,
+                     "unknown header keyword 'commentary'", "(line 6)");
     expect_fail_edit(ASCII_CLOUD, "end_header\n0 0 0 1 2 3\n1 0 0 4 5 6\n0 1 0 7 8 9\n", "", RS_ERR_FORMAT,
                      "missing end_header", NULL);
     expect_fail_edit(ASCII_CLOUD, "end_header\n", "end_header extra\n", RS_ERR_FORMAT, "after end_header", NULL);
@@ -899,6 +900,38 @@ static void test_shared_head_points_600k(void)
     rs_ply_destroy(m);
 }
 
+// What mainstream readers accept and is unambiguous loads with a warning; truly malformed still fails.
+static void test_lenient_inputs_load_with_a_warning(void)
+{
+    struct { const char *file, *warning; uint32_t tris; } ok[] = {
+        {"tests/fixtures/ply/lenient_bom.ply", "byte-order mark", 0},
+        {"tests/fixtures/ply/lenient_created_by.ply", "without 'comment'", 2},
+        {"tests/fixtures/ply/lenient_face_extras.ply", "does not declare", 2},
+    };
+    for (size_t i = 0; i < RS_COUNT_OF(ok); i++) {
+        rs_ply_mesh *m = NULL;
+        rs_error err = {0};
+        rs_result r = rs_ply_load(ok[i].file, &m, &err);
+        RS_CHECK(r == RS_OK, "%s: %s", ok[i].file, err.msg);
+        if (r != RS_OK) continue;
+        RS_CHECK(m->vertex_count == 4 && m->tri_count == ok[i].tris, "%s: %u vertices, %u triangles", ok[i].file,
+                 m->vertex_count, m->tri_count);
+        RS_CHECK(strstr(m->warnings, ok[i].warning) != NULL, "%s: warnings '%s'", ok[i].file, m->warnings);
+        if (i == 1) RS_CHECK(strstr(m->comments, "Created by Blender 2.47") != NULL, "comments '%s'", m->comments);
+        rs_ply_destroy(m);
+    }
+    rs_ply_mesh *m = NULL;
+    rs_error err = {0};
+    RS_CHECK(rs_ply_load("tests/fixtures/bad/ply_vertex_extra_values.ply", &m, &err) != RS_OK &&
+                 strstr(err.msg, "vertex 0: more values than the header declares"),
+             "a vertex with an undeclared value: %s", m ? "accepted" : err.msg);
+    rs_ply_destroy(m);
+    // After the first element an unknown keyword is still an error (a typo would drop a property).
+    const char *typo = "ply\nformat ascii 1.0\nelement vertex 1\npropety float x\nend_header\n0\n";
+    RS_CHECK(rs_ply_load_memory(typo, strlen(typo), &m, &err) != RS_OK && strstr(err.msg, "unknown header keyword"),
+             "typo: %s", err.msg);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -932,5 +965,6 @@ int main(int argc, char **argv)
     RS_RUN(test_shared_head_mesh);
     RS_RUN(test_shared_demosthenes_points_100k);
     RS_RUN(test_shared_head_points_600k);
+    RS_RUN(test_lenient_inputs_load_with_a_warning);
     return rs_test_finish();
 }

@@ -253,6 +253,12 @@ static int convert(options *o)
     double t0 = rs_time_now();
     rs_ply_mesh *mesh = NULL;
     if (rs_ply_load(o->input, &mesh, &err) != RS_OK) return fail(1, "%s", err.msg);
+    // Shown even with -q: the file was accepted on a reading the format does not spell out.
+    if (mesh->warnings[0]) {
+        char w[sizeof mesh->warnings * 4];
+        rs_text_sanitize(w, sizeof w, mesh->warnings, strlen(mesh->warnings));
+        fprintf(stderr, "rouge-pack: warning: %s: %s\n", o->input, w);
+    }
     rs_image img[4] = {{0}};
     const rs_image **slot[4] = {&o->desc.texture, &o->desc.normal_map, &o->desc.specular_map, &o->desc.region_map};
     for (int k = 0; k < 4; k++) {

@@ -113,6 +113,7 @@ typedef struct ply_reader {
     uint32_t line;        // 1-based; header lines, then ASCII body lines
     bool in_header;       // messages give the line (header, ASCII) or the byte (binary body)
     bool have_format;
+    bool warned_face_extra;
     ply_format format;
     rs_error *err;
     char *text;           // NUL-terminated header copy; names point into it
@@ -141,6 +142,16 @@ static rs_result fail(ply_reader *r, rs_result code, const char *fmt, ...)
     if (r->in_header || r->format == PLY_ASCII)
         return rs_fail(r->err, code, "%s%s: %s (line %u)", dots, name, what, r->line);
     return rs_fail(r->err, code, "%s%s: %s (byte %zu)", dots, name, what, r->pos);
+}
+
+// Notes what was accepted though the format does not allow it (mainstream readers accept it too and the
+// meaning is unambiguous), with the line, for the caller to show.
+static void warn(ply_reader *r, const char *what)
+{
+    char *w = r->mesh->warnings;
+    size_t n = strlen(w);
+    if (n + 4 < sizeof r->mesh->warnings)
+        snprintf(w + n, sizeof r->mesh->warnings - n, "%s%s (line %u)", n ? "; " : "", what, r->line);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -262,6 +273,8 @@ static rs_result header_line(ply_reader *r, char *s, size_t *comments_len, bool 
     }
     if (strncmp(s, "comment", 7) == 0 && (!s[7] || is_blank(s[7])))
         return header_comment(r, s + 7, comments_len);
+    char whole[PLY_MAX_LINE + 1];  // split() cuts s into tokens; free text before the elements keeps it whole
+    snprintf(whole, sizeof whole, "%s", s);
     char *tok[6];
     unsigned n = split(s, tok, RS_COUNT_OF(tok));
     if (n == 0) return RS_OK;  // blank line: tolerated
@@ -273,6 +286,13 @@ static rs_result header_line(ply_reader *r, char *s, size_t *comments_len, bool 
         if (n != 1) return fail(r, RS_ERR_FORMAT, "text after end_header");
         *ended = true;
         return RS_OK;
+    }
+    // Some writers (Blender 2.47: "Created by Blender ...") put free text before the elements without
+    // "comment": kept as a comment. After the first element an unknown keyword is an error (a typo there
+    // would silently drop a property).
+    if (r->elem_count == 0) {
+        warn(r, "header text without 'comment' taken as a comment");
+        return header_comment(r, whole, comments_len);
     }
     return fail(r, RS_ERR_FORMAT, "unknown header keyword '%.40s'", tok[0]);
 }
@@ -291,6 +311,13 @@ static rs_result read_header_lines(ply_reader *r)
     size_t comments_len = 0;
     bool ended = false;
     r->pos = 0;
+    // A UTF-8 byte-order mark before "ply" (Windows editors write one) carries no meaning: skip it.
+    if (limit >= 3 && memcmp(r->data, "\xef\xbb\xbf", 3) == 0) {
+        r->pos = 3;
+        r->line = 1;
+        warn(r, "UTF-8 byte-order mark before 'ply' skipped");
+        r->line = 0;
+    }
     while (!ended) {
         r->line++;
         if (r->pos >= limit) {
@@ -698,8 +725,14 @@ static rs_result read_ascii_record(ply_reader *r, const ply_element *e, uint32_t
         }
     }
     while (r->pos < r->len && is_space(r->data[r->pos])) r->pos++;
-    if (r->pos < r->len && r->data[r->pos] != '\n')
-        return fail(r, RS_ERR_FORMAT, "%.64s %u: more values than the header declares", e->name, rec);
+    if (r->pos < r->len && r->data[r->pos] != '\n') {
+        // Faces with undeclared trailing values (trimesh's and some exporters' per-face extras): the
+        // declared list is complete, so the rest of the line is skipped. Vertices stay strict.
+        if (e != r->face) return fail(r, RS_ERR_FORMAT, "%.64s %u: more values than the header declares", e->name, rec);
+        if (!r->warned_face_extra) warn(r, "faces carry values the header does not declare: ignored");
+        r->warned_face_extra = true;
+        while (r->pos < r->len && r->data[r->pos] != '\n') r->pos++;
+    }
     return RS_OK;
 }
 

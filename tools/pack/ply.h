@@ -33,6 +33,7 @@ typedef struct rs_ply_mesh {
     uint32_t (*tri)[3];   // NULL when the file has no faces; indices validated < vertex_count
     char *comments;       // header comments joined by '\n' (carries the CC-BY attribution), never NULL
     char *texture_file;   // from "comment TextureFile NAME" (MeshLab convention), or NULL
+    char warnings[512];   // what was accepted though not by the letter of the format ("; "-joined), or ""
 } rs_ply_mesh;
 
 rs_result rs_ply_load(const char *path, rs_ply_mesh **out, rs_error *err);
