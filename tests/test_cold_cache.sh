@@ -16,7 +16,7 @@ trap 'rm -rf "$tmp"' EXIT
 rouge="$build/rouge"
 
 if selected cold_cache_render_matches_warm; then
-    "$build/rouge-pack" tests/fixtures/ply/mesh_st.ply --points 3000 -o "$tmp/face.rsf" -q
+    "$build/rouge-pack" tests/fixtures/ply/mesh_st.ply --points 3000 -o "$tmp/face.rsf" -q 2>/dev/null
     args="render $tmp/face.rsf --size 48x48 --pipeline mobile"
     # shellcheck disable=SC2086
     "$rouge" $args -o "$tmp/warm.png" >"$tmp/warm.log" 2>&1

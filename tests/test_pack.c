@@ -636,6 +636,27 @@ static void test_nonfinite_input_normals_are_reestimated(void)
     rs_splat_destroy(c);
 }
 
+// A model that is no face is framed whole: the "face height" the camera fits is its bounding sphere.
+static void test_non_face_is_framed_by_its_bounding_sphere(void)
+{
+    rs_ply_mesh *m = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_ply_load("tests/fixtures/ply/mesh_two_cubes.ply", &m, &err) == RS_OK, "%s", err.msg);
+    rs_pack_desc d = {.points = 5000, .all_components = true};
+    rs_splat_cloud *c = NULL;
+    rs_pack_report rep;
+    rs_result r = rs_pack_convert(m, &d, &c, &rep, &err);
+    rs_ply_destroy(m);
+    RS_REQUIRE(r == RS_OK, "%s", err.msg);
+    float diag = sqrtf(3.5f * 3.5f + 1 + 1);
+    RS_CHECK(!rep.face.found, "a face in two cubes");
+    RS_CHECK(fabsf(c->hdr.face_height - diag) < 0.02f * diag, "face height %g, bounding diameter %g",
+             c->hdr.face_height, diag);
+    RS_CHECK(fabsf(c->hdr.centre[0] - 1.75f) < 0.02f && fabsf(c->hdr.centre[1] - 0.5f) < 0.02f, "centre %g %g",
+             c->hdr.centre[0], c->hdr.centre[1]);
+    rs_splat_destroy(c);
+}
+
 static void test_convert_rejects_bad_inputs_with_clear_errors(void)
 {
     float p[4][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {NAN, 0, 0}};
@@ -762,6 +783,7 @@ int main(int argc, char **argv)
     RS_RUN(test_knn_of_identical_points_is_fast_and_zero);
     RS_RUN(test_normals_on_sphere_point_outward);
     RS_RUN(test_nonfinite_input_normals_are_reestimated);
+    RS_RUN(test_non_face_is_framed_by_its_bounding_sphere);
     RS_RUN(test_normals_on_demosthenes_agree_with_given);
     RS_RUN(test_radius_matches_grid_spacing);
     RS_RUN(test_lod_prefix_is_spatially_uniform);

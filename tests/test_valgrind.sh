@@ -80,7 +80,7 @@ memcheck valgrind_pack_textured_mesh 0 "$pack" $fx/ply/mesh_st.ply --points 3000
 
 # The face for the renders, converted natively (the conversion was checked above), and a short stroke
 # (three samples: every stamp renders the ID buffer, which is slow under valgrind).
-"$pack" $fx/ply/mesh_st.ply --points 3000 --texture $fx/image/a_8x8.png -o "$tmp/face.rsf" -q
+"$pack" $fx/ply/mesh_st.ply --points 3000 --texture $fx/image/a_8x8.png -o "$tmp/face.rsf" -q 2>/dev/null
 printf 'rouge-strokes 1\nview yaw=0 pitch=0 zoom=1 fov=30 size=48x48\n%s\ncosmetic blush\nstroke\n%s\nend\n' \
     "brush size=0.3 opacity=0.8 pressure=floor mirror=1 eraser=0" \
     "s 0.00 20.0 24.0 0.5

@@ -8,17 +8,18 @@
 #   tools/fuzz/fuzz_rsf.c    rs_splat_load_memory (src/splat)  tests/fixtures/rsf
 #   tools/fuzz/fuzz_strokes.c rs_strokes_parse (src/formats/strokes.c) tests/fixtures/strokes
 #   tools/fuzz/fuzz_look.c   rs_look_parse + apply (src/formats/look.c) tests/fixtures/looks
+#   tools/fuzz/fuzz_convert.c PLY -> convert -> preview -> save/load  tests/fixtures/ply + bad/ply_*
 # plus, for each, the inputs kept from earlier crashes: tests/fixtures/bad/fuzz/<name>/ (run first, as
 # regression tests; the ordinary test suite also feeds them to the real programs, tests/test_robustness.sh).
 #
-# Environment: FUZZ_SECONDS (default 60 per harness), FUZZ_TARGETS (default "ply rsf strokes look"),
+# Environment: FUZZ_SECONDS (default 60 per harness), FUZZ_TARGETS (default "ply rsf strokes look convert"),
 # FUZZ_DIR (default build/fuzz), FUZZ_JOBS (parallel harness runs, default 1: the machine may be shared).
 # Exit status: 0 no crash, 1 a crash/leak/timeout (the reproducer's path is printed), 2 cannot build.
 # Needs clang with libFuzzer and the sanitizer runtimes (Debian: clang, libclang-rt-14-dev).
 set -u
 cd "$(dirname "$0")/.." || exit 2
 seconds=${FUZZ_SECONDS:-60}
-targets=${FUZZ_TARGETS:-ply rsf strokes look}
+targets=${FUZZ_TARGETS:-ply rsf strokes look convert}
 dir=${FUZZ_DIR:-build/fuzz}
 jobs=${FUZZ_JOBS:-1}
 cc=${FUZZ_CC:-clang}
@@ -48,7 +49,7 @@ make --no-print-directory -s BUILD="$dir/lib" CC="$cc" OPT=-O1 \
 pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm 2>/dev/null)
 for t in $targets; do
     src="tools/fuzz/fuzz_$t.c"
-    [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look)"
+    [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert)"
     # shellcheck disable=SC2086
     "$cc" -std=c11 -g -O1 -Wall -Wextra -Werror -fsanitize=fuzzer $san -Isrc -Itools "$src" \
         "$dir/lib/libpack.a" "$dir/lib/librouge.a" $pkgs -lm -o "$dir/fuzz_$t" 2>"$dir/fuzz_$t.log" ||
@@ -61,6 +62,7 @@ seeds_of() {
         rsf) echo tests/fixtures/rsf ;;
         strokes) echo tests/fixtures/strokes ;;
         look) echo tests/fixtures/looks ;;
+        convert) echo tests/fixtures/ply ;;
     esac
 }
 
@@ -79,7 +81,10 @@ run_one() {
     fi
     mkdir -p "$corpus" "$crashes"
     # Seeds are copied (never fuzzed in place: libFuzzer writes new inputs into its corpus directory).
-    for f in "$(seeds_of "$t")"/* tests/fixtures/bad/fuzz/"$t"/*; do
+    extra=""
+    [ "$t" = convert ] && extra="tests/fixtures/bad/ply_*"
+    # shellcheck disable=SC2086
+    for f in "$(seeds_of "$t")"/* tests/fixtures/bad/fuzz/"$t"/* $extra; do
         [ -f "$f" ] && cp "$f" "$corpus/"
     done
     dict=""

@@ -286,6 +286,17 @@ static int convert(options *o)
     rs_pack_report rep;
     rs_splat_cloud *cloud = NULL;
     rs_result r = rs_pack_convert(mesh, &o->desc, &cloud, &rep, &err);
+    // No face in the largest component (a cube, Suzanne, a bust's base): the face defaults would drop the
+    // rest of the model, so convert the whole model instead, and say so.
+    bool whole = false;
+    if (r == RS_OK && !rep.face.found && rep.triangles_dropped > 0 && !o->desc.all_components) {
+        rs_pack_desc all = o->desc;
+        all.all_components = true;
+        rs_splat_destroy(cloud);
+        cloud = NULL;
+        r = rs_pack_convert(mesh, &all, &cloud, &rep, &err);
+        whole = true;
+    }
     if (bar.on) fputs("\r\033[K", stderr);
     for (int k = 0; k < 4; k++) rs_image_free(&img[k]);
     rs_ply_destroy(mesh);
@@ -310,6 +321,10 @@ static int convert(options *o)
         return fail(1, "%s", err.msg);
     }
     if (!o->quiet) print_summary(o, cloud, &rep, load_s, save_s);
+    // Said even with -q (on stderr, once the file is written): the result is not what the face defaults give.
+    if (!rep.face.found)
+        fprintf(stderr, "rouge-pack: note: %s: no face found (assumed +y up, +z forward); converted %s as a plain "
+                        "model, framed by its bounding box\n", o->input, whole ? "every component" : "it");
     rs_splat_destroy(cloud);
     return 0;
 }

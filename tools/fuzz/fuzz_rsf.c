@@ -2,12 +2,14 @@
 // (tools/fuzz.sh); by hand:
 //   clang -g -O1 -fsanitize=fuzzer,address,undefined -Isrc tools/fuzz/fuzz_rsf.c src/splat/splat.c \
 //       src/splat/rsf_io.c src/core/core.c -lm -o /tmp/fuzz_rsf && /tmp/fuzz_rsf -dict=tools/fuzz/rsf.dict DIR
-// Seed corpus: tests/fixtures/rsf/. Any input must load or fail cleanly (no crash, leak, hang or
+// Seed corpus: tests/fixtures/rsf/. Files that load also go through the converter's preview (the
+// `--info --preview` path), so the header fields reach its projection with the CRC fixed up. Any input must load or fail cleanly (no crash, leak, hang or
 // allocation beyond the input's size), failures must leave the output pointer alone and say why, and a
 // file that loads must save back to the same bytes (docs/rsf.md: "save(load(f)) gives back f").
 //
 // Random bytes almost never get past the CRC, so inputs whose stored CRC is wrong are also tried with the
 // CRC recomputed: the fuzzer then reaches the field checks behind it.
+#include "pack/pack.h"
 #include "splat/splat.h"
 
 #include <stddef.h>
@@ -34,6 +36,10 @@ static void load_one(const uint8_t *data, size_t size)
     size_t len = 0;
     if (rs_splat_save_memory(c, &back, &len, &err) != RS_OK) __builtin_trap();
     if (len != size || memcmp(back, data, size) != 0) __builtin_trap();
+    // What `rouge-pack --info --preview` does with a valid header: the preview rasteriser projects every
+    // splat by the header's frame (its float-to-int casts were once undefined for such files).
+    rs_image img = {0};
+    if (rs_pack_preview(c, 32, &img, &err) == RS_OK) rs_image_free(&img);
     free(back);
     rs_splat_destroy(c);
 }

@@ -416,9 +416,11 @@ rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uin
         hi[1] = fmaxf(hi[1], u);
         frontish += normal && dot3(normal[i], f.forward) > 0.3f;
     }
+    // Not a face: the whole model is framed, so its bounding sphere's diameter stands in for the face
+    // height (the camera's zoom 1 fits it from any side). A face found below replaces both.
     for (int a = 0; a < 3; a++) f.centre[a] = 0.5f * (mn[a] + mx[a]);
-    f.face_height = hi[1] - lo[1];
-    if (!(f.face_height > 0)) f.face_height = 1.0f;
+    f.face_height = (float)hypot(hypot((double)mx[0] - mn[0], (double)mx[1] - mn[1]), (double)mx[2] - mn[2]);
+    if (!(f.face_height > 0) || !isfinite(f.face_height)) f.face_height = 1.0f;
     if (count < 100) {  // too few points to read a face from
         *out = f;
         return RS_OK;
