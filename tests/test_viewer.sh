@@ -212,12 +212,16 @@ fi
 if selected viewer_bad_dropped_file_keeps_the_face; then
     name=viewer_bad_dropped_file_keeps_the_face
     head -c 1000 "$face" >"$out/dropped.rsf"
+    # A FIFO dropped too: opening it once blocked the loader, and then the viewer could not be quit.
+    rm -f "$out/dropped.fifo" && mkfifo "$out/dropped.fifo"
     {
         echo "key i"
         echo "move 400 580"
         echo "idle"
         echo "screenshot $out/dbefore_face.png 80 80 630 180"
         echo "drop $out/dropped.rsf"
+        echo "wait 1.5"
+        echo "drop $out/dropped.fifo"
         echo "wait 1.5"
         echo "idle"
         echo "screenshot $out/dafter_face.png 80 80 630 180"
