@@ -5,7 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-typedef enum { OPT_FLOAT, OPT_INT, OPT_SIZE, OPT_RGB, OPT_ENUM, OPT_FLAG, OPT_PATH } opt_kind;
+typedef enum { OPT_FLOAT, OPT_INT, OPT_SIZE, OPT_RGB, OPT_PAN, OPT_ENUM, OPT_FLAG, OPT_PATH } opt_kind;
 
 typedef struct opt {
     const char *name;
@@ -24,6 +24,8 @@ static const opt opts[] = {
     {"--yaw", OPT_FLOAT, "DEG", "camera yaw around the face (0 = frontal, + = towards the subject's left)", -360, 360},
     {"--pitch", OPT_FLOAT, "DEG", "camera pitch (+ = from above)", -89, 89},
     {"--zoom", OPT_FLOAT, "Z", "1 = face fills the view; 2 = twice as close", 0.1f, 20},
+    {"--pan", OPT_PAN, "X,Y", "shift the picture by X,Y view heights (+x right, +y down; -2..2)", -RS_VIEW_PAN_MAX, RS_VIEW_PAN_MAX},
+    {"--target", OPT_PATH, "REGION", "centre and zoom on a region of the face (lips, nose, cheek, forehead, ...)", 0, 0},
     {"--fov", OPT_FLOAT, "DEG", "vertical field of view (default 30; 1..150)", RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG},
     {"--light-yaw", OPT_FLOAT, "DEG", "key light direction, yaw", -360, 360},
     {"--light-pitch", OPT_FLOAT, "DEG", "key light direction, pitch (+ = from above)", -90, 90},
@@ -120,6 +122,16 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
         c->size_set = true;
         return RS_OK;
     }
+    if (o->kind == OPT_PAN) {
+        float p[2];
+        char extra;
+        if (sscanf(v, "%f,%f%c", &p[0], &p[1], &extra) != 2 || !isfinite(p[0]) || !isfinite(p[1]) || p[0] < o->lo ||
+            p[0] > o->hi || p[1] < o->lo || p[1] > o->hi)
+            return rs_fail(err, RS_ERR_ARG, "%s: expected X,Y within %g..%g, got '%s'", n, o->lo, o->hi, v);
+        w->pan[0] = p[0], w->pan[1] = p[1];
+        c->pan_set = true;
+        return RS_OK;
+    }
     if (o->kind == OPT_RGB) {
         float rgb[3];
         char extra;
@@ -151,6 +163,7 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--lod-density")) w->lod_density = f;
     else if (!strcmp(n, "--strokes")) c->strokes = v;
     else if (!strcmp(n, "--look")) c->look = v;
+    else if (!strcmp(n, "--target")) c->target = v;
     else if (!strcmp(n, "--save-look")) c->save_look = v;
     else if (!strcmp(n, "--record")) c->record = v;
     else if (!strcmp(n, "--fullscreen")) c->fullscreen = true;

@@ -18,6 +18,8 @@ typedef struct rs_cli {
     const char *output;     // -o PNG
     const char *strokes;    // --strokes FILE: replay painting
     const char *look;       // --look FILE: apply a saved look
+    const char *target;     // --target REGION: frame a region of the face
+    bool pan_set;           // --pan given (it then also shifts a --target or stroke file's framing)
     const char *save_look;  // --save-look FILE: save the look after replaying strokes
     const char *record;     // --record FILE: viewer records strokes
     const char *events;     // --events FILE: viewer replays an event script (tests, demos)

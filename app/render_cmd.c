@@ -67,6 +67,7 @@ static rouge_result paint(const rs_cli *cli, rouge_face *face, rouge_error *e)
         if (!cli->view_set[1]) v.pitch_deg = cam.pitch_deg;
         if (!cli->view_set[2]) v.zoom = cam.zoom;
         if (!cli->view_set[3]) v.fov_deg = cam.fov_deg;
+        if (!cli->pan_set) v.pan[0] = cam.pan[0], v.pan[1] = cam.pan[1];
         if (!r) r = rouge_face_set_view(face, &v, e);
     }
     return r;
@@ -101,6 +102,13 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
     rouge_view view = rs_app_public_view(&cli->view);
     rouge_result r = rouge_face_create(&(rouge_face_desc){.path = path, .view = &view}, &face, &e);
     if (!r) r = paint(cli, face, &e);
+    if (!r && cli->target) {
+        r = rouge_face_target(face, cli->target, 0, &e);
+        // --pan then shifts the framed region.
+        rouge_view t = rouge_face_get_view(face);
+        t.pan[0] += cli->view.pan[0], t.pan[1] += cli->view.pan[1];
+        if (!r) r = rouge_face_set_view(face, &t, &e);
+    }
     if (!r) r = rouge_face_render(face, &e);
     // The look is saved only once the render it belongs to has succeeded, and before the PNG, so a look
     // that cannot be written leaves no picture claiming it was.

@@ -468,7 +468,7 @@ static void feed_paint(vw_viewer *v, rs_input_type type, int id, float x, float 
     if (type == RS_INPUT_DOWN && v->rec && v->paint_mode) {
         // The stroke file records the camera the pixels refer to.
         rs_strokes_view sv = {v->view.yaw_deg, v->view.pitch_deg, v->view.zoom, v->view.fov_deg,
-                              (uint32_t)v->fb_w, (uint32_t)v->fb_h};
+                              (uint32_t)v->fb_w, (uint32_t)v->fb_h, {v->view.pan[0], v->view.pan[1]}};
         rs_paint_set_recorder(v->paint, v->rec, &sv);
     }
     rs_input_event ev = {type, id, x, y, 1.0f, t};

@@ -179,6 +179,11 @@ void rouge_face_destroy(rouge_face *face);
 rouge_result rouge_face_set_view(rouge_face *face, const rouge_view *view, rouge_error *err);
 // The view as set, with the camera as navigation left it.
 rouge_view rouge_face_get_view(const rouge_face *face);
+// Frames a region of the face ("lips", "nose", "cheek", "forehead", ...: the names in the face's region
+// table) from the current yaw and pitch: centres it and zooms so it fills about `fill` of the view height
+// (0 = 0.4). A region on both sides of the face is framed on the side facing the camera more.
+// ROUGE_ERR_ARG for a name the face does not have (the message lists those it has).
+rouge_result rouge_face_target(rouge_face *face, const char *region, float fill, rouge_error *err);
 // Navigation in pixels of the last frame (what gestures do; for keys, wheels and your own gestures).
 void rouge_face_orbit(rouge_face *face, float yaw_deg, float pitch_deg);
 void rouge_face_pan(rouge_face *face, float dx_px, float dy_px);

@@ -290,6 +290,94 @@ rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_er
 
 rouge_view rouge_face_get_view(const rouge_face *f) { return f->view; }
 
+rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, rouge_error *err)
+{
+    const rs_splat_header *h = &f->cloud->hdr;
+    int idx = -1;
+    char names[RS_SPLAT_MAX_REGIONS * 17] = "";
+    for (uint32_t k = 0; k < h->region_count; k++) {
+        if (region && strcmp(h->regions[k].name, region) == 0) idx = (int)k;
+        snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", k ? "|" : "", h->regions[k].name);
+    }
+    if (idx < 0) {
+        rs_error e = {0};
+        rs_fail(&e, RS_ERR_ARG, "target: no region '%.32s' in this face (it has %s)", region ? region : "", names);
+        return fail_out(err, &e);
+    }
+    if (!(fill > 0)) fill = 0.4f;
+    int w = f->view.width > 0 ? f->view.width : 512, ht = f->view.height > 0 ? f->view.height : 512;
+    rouge_view saved = f->view;
+    f->view.pan[0] = f->view.pan[1] = 0;
+    rs_view v = to_rs_view(&f->view, w, ht);
+    // The region's splats that face the camera, each half of the face apart: a region on both sides
+    // (cheeks) is framed on the side that faces the camera more, not between the two.
+    float side[3] = {h->up[1] * h->forward[2] - h->up[2] * h->forward[1],
+                     h->up[2] * h->forward[0] - h->up[0] * h->forward[2],
+                     h->up[0] * h->forward[1] - h->up[1] * h->forward[0]};
+    double sum[2][3] = {{0}}, facing[2] = {0};
+    uint32_t n[2] = {0}, middle = 0;
+    for (uint32_t i = 0; i < h->count; i++) {
+        if ((int)(f->cloud->packed[i].w[1] >> 24) != idx) continue;
+        const float *p = f->cloud->pos[i], *nrm = f->cloud->normal[i];
+        float dir[3];
+        rs_render_view_dir(f->ren, &v, p, dir);
+        float d = nrm[0] * dir[0] + nrm[1] * dir[1] + nrm[2] * dir[2];
+        if (d < 0.2f) continue;
+        float sd = (p[0] - h->centre[0]) * side[0] + (p[1] - h->centre[1]) * side[1] + (p[2] - h->centre[2]) * side[2];
+        int s = sd >= 0;
+        middle += fabsf(sd) < 0.05f * h->face_height;
+        for (int a = 0; a < 3; a++) sum[s][a] += p[a];
+        facing[s] += d;
+        n[s]++;
+    }
+    if (n[0] + n[1] == 0) {
+        f->view = saved;
+        rs_error e = {0};
+        rs_fail(&e, RS_ERR_ARG, "target: region '%s' does not face the camera from this view", region);
+        return fail_out(err, &e);
+    }
+    int pick = -1;  // -1: both halves together
+    uint32_t all = n[0] + n[1];
+    // Two-sided when the region has (almost) nothing near the mid-plane: cheeks, not lips or nose.
+    if (n[0] > all / 4 && n[1] > all / 4 && middle < all / 20) pick = facing[1] / n[1] > facing[0] / n[0] ? 1 : 0;
+    double c[3] = {0};
+    uint32_t cn = pick < 0 ? all : n[pick];
+    for (int a = 0; a < 3; a++) c[a] = (pick < 0 ? sum[0][a] + sum[1][a] : sum[pick][a]) / cn;
+    // Size: twice the RMS distance of those splats from their centre.
+    double ss = 0;
+    for (uint32_t i = 0; i < h->count; i++) {
+        if ((int)(f->cloud->packed[i].w[1] >> 24) != idx) continue;
+        const float *p = f->cloud->pos[i], *nrm = f->cloud->normal[i];
+        int s = ((p[0] - h->centre[0]) * side[0] + (p[1] - h->centre[1]) * side[1] + (p[2] - h->centre[2]) * side[2]) >= 0;
+        if (pick >= 0 && s != pick) continue;
+        float dir[3];
+        rs_render_view_dir(f->ren, &v, p, dir);
+        if (nrm[0] * dir[0] + nrm[1] * dir[1] + nrm[2] * dir[2] < 0.2f) continue;
+        ss += (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
+    }
+    double size = 2.0 * sqrt(ss / (double)cn);
+    // Zoom moves the camera along its ray towards the face centre (render.c: distance = 0.625 H /
+    // tan(fov/2) / zoom). Put it where the region, d_r in front of the centre, spans `fill` of the view.
+    float toward[3], hc[3] = {h->centre[0], h->centre[1], h->centre[2]};
+    rs_render_view_dir(f->ren, &v, hc, toward);
+    double d_r = (c[0] - hc[0]) * toward[0] + (c[1] - hc[1]) * toward[1] + (c[2] - hc[2]) * toward[2];
+    double t = tan(0.5 * v.fov_deg * 3.14159265358979 / 180.0);
+    double dist = d_r + (size > 0 ? size : h->face_height) / (2.0 * t * fill);
+    float zoom = dist > 0 ? (float)(0.625 * h->face_height / t / dist) : 1.0f;
+    f->view.zoom = RS_CLAMP(zoom, 1.0f, 10.0f);
+    v = to_rs_view(&f->view, w, ht);
+    float centre[3] = {(float)c[0], (float)c[1], (float)c[2]}, px[2];
+    if (!rs_render_project(f->ren, &v, centre, px)) {
+        f->view = saved;
+        return fail_arg(err, "target: the region is behind the camera");
+    }
+    // The pan moves the picture by pan * view height pixels (x right, y down).
+    f->view.pan[0] = -(px[0] - 0.5f * (float)w) / (float)ht;
+    f->view.pan[1] = -(px[1] - 0.5f * (float)ht) / (float)ht;
+    f->changed = true;
+    return ROUGE_OK;
+}
+
 void rouge_face_orbit(rouge_face *f, float yaw_deg, float pitch_deg)
 {
     f->view.yaw_deg = fmodf(f->view.yaw_deg + yaw_deg, 360.0f);
@@ -556,7 +644,8 @@ void rouge_face_set_painting(rouge_face *f, bool painting)
 
 static rs_strokes_view strokes_view(const rs_view *v)
 {
-    return (rs_strokes_view){v->yaw_deg, v->pitch_deg, v->zoom, v->fov_deg, (uint32_t)v->width, (uint32_t)v->height};
+    return (rs_strokes_view){v->yaw_deg, v->pitch_deg, v->zoom, v->fov_deg, (uint32_t)v->width, (uint32_t)v->height,
+                             {v->pan[0], v->pan[1]}};
 }
 
 rouge_result rouge_face_pointer(rouge_face *f, const rouge_pointer_event *ev, rouge_pointer_result *out,
@@ -686,6 +775,7 @@ rouge_result rouge_face_play_strokes(rouge_face *f, const char *path, rouge_erro
         const rs_strokes_view *sv = &doc->strokes[i].view;
         f->view.yaw_deg = sv->yaw_deg, f->view.pitch_deg = sv->pitch_deg;
         f->view.zoom = sv->zoom, f->view.fov_deg = sv->fov_deg;
+        f->view.pan[0] = sv->pan[0], f->view.pan[1] = sv->pan[1];
         f->frame_view = to_rs_view(&f->view, (int)sv->width_px, (int)sv->height_px);
         f->have_frame = true;
         rs_paint_result res;

@@ -65,6 +65,10 @@ no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
 # Memory: the frame size is bounded by what its render targets cost, said in the error.
 expect cli_size_bounded_by_target_memory 1 "needs about 3.7 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
 no_file cli_size_memory_leaves_no_output "$tmp/m.png"
+expect cli_pan_out_of_range 2 "--pan: expected X,Y within -2..2" "$rouge" render "$face" -o "$tmp/p.png" --pan 3,0
+expect cli_target_unknown_region_lists_them 2 "no region 'elbow' in this face (it has other|cheek|nose|forehead|lips)" \
+    "$rouge" render "$face" -o "$tmp/p.png" --size 32x32 --max-splats 2000 --target elbow
+no_file cli_target_unknown_leaves_no_output "$tmp/p.png"
 expect cli_second_output_refused 2 "-o given twice" "$rouge" render "$face" -o "$tmp/j.png" -o "$tmp/k.png"
 cp tests/fixtures/strokes/lips.strokes "$tmp/in.strokes"
 expect cli_output_equal_to_input_refused 2 "is an input of this render" \

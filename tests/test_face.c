@@ -11,6 +11,7 @@
 
 #include <stdio.h>
 #include <stdlib.h>
+#include <math.h>
 #include <string.h>
 
 #define SIZE 96
@@ -255,6 +256,65 @@ static void test_errors_are_values(void)
     RS_CHECK(!strcmp(rouge_result_name(ROUGE_ERR_GL), "ROUGE_ERR_GL"), "result names");
 }
 
+// --target frames a region: measured on the picture, the splat under the view's centre belongs to it and
+// the frame is closer than the whole-face view; an unknown name lists the face's regions.
+static void test_target_centres_each_region(void)
+{
+    const char *names[] = {"lips", "nose", "forehead", "cheek"};
+    const int ids[] = {4, 2, 3, 1};  // the bundled face's region table (docs/regions.md)
+    rouge_error e = {0};
+    for (int i = 0; i < 4; i++) {
+        rouge_view v = small_view();
+        RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+        RS_CHECK(rouge_face_target(face, names[i], 0, &e) == ROUGE_OK, "%s: %s", names[i], e.msg);
+        RS_CHECK(rouge_face_get_view(face).zoom > 1.2f, "%s: zoom %g", names[i], rouge_face_get_view(face).zoom);
+        RS_CHECK(rouge_face_render(face, &e) == ROUGE_OK, "%s", e.msg);
+        // Where the region is in the picture, measured by picking a grid: its centroid must sit at the
+        // view's centre, and it must cover a good part of the view.
+        double sx = 0, sy = 0;
+        int n = 0, step = 4;
+        for (int y = step / 2; y < SIZE; y += step)
+            for (int x = step / 2; x < SIZE; x += step) {
+                rouge_pick p;
+                if (rouge_face_pick(face, (float)x, (float)y, &p) && p.region == ids[i]) sx += x, sy += y, n++;
+            }
+        int cells = (SIZE / step) * (SIZE / step);
+        RS_CHECK(n > cells / 20, "%s: covers %d of %d grid points", names[i], n, cells);
+        if (n > 0)
+            RS_CHECK(fabs(sx / n - SIZE / 2.0) < 0.08 * SIZE && fabs(sy / n - SIZE / 2.0) < 0.08 * SIZE,
+                     "%s: centroid at (%.1f, %.1f) of a %d px view", names[i], sx / n, sy / n, SIZE);
+    }
+    RS_CHECK(rouge_face_target(face, "elbow", 0, &e) == ROUGE_ERR_ARG && strstr(e.msg, "lips") != NULL,
+             "unknown region: %s", e.msg);
+    rouge_view v = small_view();
+    rouge_face_set_view(face, &v, &e);
+}
+
+// --pan shifts the picture: the panned frame is the unpanned one moved by pan x view height pixels.
+static void test_pan_shifts_the_picture(void)
+{
+    rouge_error e = {0};
+    rouge_view v = small_view();
+    rs_image a = {0}, b = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK && frame(&a), "%s", e.msg);
+    v.pan[0] = 0.125f, v.pan[1] = -0.0625f;  // 12 px right, 6 px up at 96 px
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK && frame(&b), "%s", e.msg);
+    int dx = 12, dy = -6, bad = 0, n = 0;
+    for (int y = 10; y < SIZE - 10; y++)
+        for (int x = 14; x < SIZE - 14; x++, n++) {
+            const uint8_t *pa = a.pixels + ((size_t)y * SIZE + x) * 4, *pb = b.pixels + ((size_t)(y + dy) * SIZE + x + dx) * 4;
+            for (int c = 0; c < 3; c++)
+                if (abs(pa[c] - pb[c]) > 24) {
+                    bad++;
+                    break;
+                }
+        }
+    RS_CHECK(bad < n / 50, "%d of %d pixels differ from the shifted unpanned frame", bad, n);
+    rs_image_free(&a), rs_image_free(&b);
+    v = small_view();
+    rouge_face_set_view(face, &v, &e);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -274,6 +334,8 @@ int main(int argc, char **argv)
     RS_RUN(test_draw_into_host_framebuffer_restores_state);
     RS_RUN(test_paint_undo_redo_and_look_in_memory);
     RS_RUN(test_errors_are_values);
+    RS_RUN(test_target_centres_each_region);
+    RS_RUN(test_pan_shifts_the_picture);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
     return rs_test_finish();

@@ -64,6 +64,7 @@ double rs_time_now(void);
 #define RS_VIEW_MAX_SIZE_PX 8192  // frame side in pixels
 #define RS_VIEW_FOV_MIN_DEG 1.0f  // vertical field of view
 #define RS_VIEW_FOV_MAX_DEG 150.0f
+#define RS_VIEW_PAN_MAX 2.0f      // screen shift, fractions of the view height
 
 #define RS_COUNT_OF(a) (sizeof(a) / sizeof((a)[0]))
 #define RS_MIN(a, b) ((a) < (b) ? (a) : (b))

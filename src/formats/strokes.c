@@ -46,6 +46,9 @@ static rs_result check_view(const rs_strokes_view *v, rs_error *err)
         return rs_fail(err, RS_ERR_FORMAT, "view: pitch: %g not in [-90, 90]", v->pitch_deg);
     if (!in_range(v->zoom, 1e-3f, 100.0f))
         return rs_fail(err, RS_ERR_FORMAT, "view: zoom: %g not in [0.001, 100]", v->zoom);
+    if (!in_range(v->pan[0], -RS_VIEW_PAN_MAX, RS_VIEW_PAN_MAX) || !in_range(v->pan[1], -RS_VIEW_PAN_MAX, RS_VIEW_PAN_MAX))
+        return rs_fail(err, RS_ERR_FORMAT, "view: pan: %g,%g not in [-%g, %g]", v->pan[0], v->pan[1], RS_VIEW_PAN_MAX,
+                       RS_VIEW_PAN_MAX);
     if (!in_range(v->fov_deg, RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG))
         return rs_fail(err, RS_ERR_FORMAT, "view: fov: %g not in [%g, %g]", v->fov_deg, RS_VIEW_FOV_MIN_DEG,
                        RS_VIEW_FOV_MAX_DEG);
@@ -178,18 +181,26 @@ static int key_index(const char *key, const char *const *keys, int n)
 
 static rs_result parse_view(parser *p, char **save)
 {
-    static const char *const keys[] = {"yaw", "pitch", "zoom", "fov", "size"};
-    bool seen[5] = {false};
+    // pan is optional (files written before it have none: unpanned).
+    static const char *const keys[] = {"yaw", "pitch", "zoom", "fov", "size", "pan"};
+    bool seen[6] = {false};
     rs_strokes_view v = {0};
     char *tok, *key, *val;
     while ((tok = strtok_r(NULL, " \t", save)) != NULL) {
         if (!split_kv(tok, &key, &val)) return perr(p, "view: '%.64s' is not key=value", tok);
-        int k = key_index(key, keys, 5);
+        int k = key_index(key, keys, 6);
         if (k < 0) return perr(p, "view: unknown key '%.32s'", key);
         if (seen[k]) return perr(p, "view: %s given twice", key);
         seen[k] = true;
         bool ok;
-        if (k == 4) {
+        if (k == 5) {
+            char *c = strchr(val, ',');
+            ok = c != NULL;
+            if (ok) {
+                *c = '\0';
+                ok = rs_text_parse_float(val, &v.pan[0]) && rs_text_parse_float(c + 1, &v.pan[1]);
+            }
+        } else if (k == 4) {
             char *x = strchr(val, 'x');
             ok = x != NULL;
             if (ok) {
@@ -395,9 +406,12 @@ rs_result rs_strokes_write_memory(const rs_strokes *doc, char **out, size_t *out
         const rs_strokes_stroke *s = &doc->strokes[i];
         const rs_strokes_view *v = &s->view;
         const rs_strokes_brush *br = &s->brush;
-        if (!prev || memcmp(v, &prev->view, sizeof *v) != 0)
-            sb_printf(&b, "view yaw=%.9g pitch=%.9g zoom=%.9g fov=%.9g size=%ux%u\n", v->yaw_deg, v->pitch_deg,
+        if (!prev || memcmp(v, &prev->view, sizeof *v) != 0) {
+            sb_printf(&b, "view yaw=%.9g pitch=%.9g zoom=%.9g fov=%.9g size=%ux%u", v->yaw_deg, v->pitch_deg,
                       v->zoom, v->fov_deg, v->width_px, v->height_px);
+            if (v->pan[0] != 0 || v->pan[1] != 0) sb_printf(&b, " pan=%.9g,%.9g", v->pan[0], v->pan[1]);
+            sb_printf(&b, "\n");
+        }
         if (!prev || br->size_rel != prev->brush.size_rel || br->opacity != prev->brush.opacity ||
             br->pressure != prev->brush.pressure || br->mirror != prev->brush.mirror ||
             br->eraser != prev->brush.eraser)

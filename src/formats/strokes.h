@@ -32,6 +32,7 @@
 typedef struct rs_strokes_view {
     float yaw_deg, pitch_deg, zoom, fov_deg;
     uint32_t width_px, height_px;
+    float pan[2];  // screen shift, fractions of the view height; file: pan=X,Y (optional, default 0,0)
 } rs_strokes_view;
 
 typedef struct rs_strokes_brush {
