@@ -46,7 +46,8 @@ struct rs_ui {
     int fb_w, fb_h;
     float scale;
     rs_ui_input in;
-    float last_x, last_y;  // pointer position in the previous frame (drag deltas)
+    float last_x, last_y;  // pointer position in the previous frame
+    float drag_x, drag_y;  // where the active drag widget last saw the pointer (its deltas start at the press)
     int active;            // widget holding the pointer, 0 none
     // Interactive rects and panels: this frame's (being built) and last frame's (for rs_ui_captures).
     rs_ui_rect hits[2][MAX_HITS];
@@ -611,11 +612,15 @@ bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, float *value
 
 bool rs_ui_drag(rs_ui *ui, int id, rs_ui_rect r, float *dx, float *dy)
 {
-    bool hot;
+    bool hot, was_active = ui->active == id;
     press_logic(ui, id, r, &hot);
     *dx = *dy = 0;
     if (ui->active != id) return false;
-    *dx = ui->in.x - ui->last_x, *dy = ui->in.y - ui->last_y;
+    // Deltas count from the press, not from where the pointer hovered the frame before: a new touch (or a
+    // click after the mouse moved) arrives somewhere else, and that jump once threw the divider 200+ px.
+    if (!was_active) ui->drag_x = ui->in.x, ui->drag_y = ui->in.y;
+    *dx = ui->in.x - ui->drag_x, *dy = ui->in.y - ui->drag_y;
+    ui->drag_x = ui->in.x, ui->drag_y = ui->in.y;
     return true;
 }
 

@@ -46,7 +46,7 @@ const vw_shortcut vw_shortcuts[] = {
     {"Left drag", "orbit; in paint mode: paint"},
     {"Right drag, scroll", "pan, zoom (touch: two fingers)"},
     {"L+drag, sun dial", "move the light"},
-    {"Arrows, +/-, 0", "orbit, zoom, reset the view"},
+    {"Arrows, +/-, 0", "orbit, zoom, reset camera and light"},
     {"P", "paint / view mode"},
     {"1-9, Tab", "pick a cosmetic; Tab: next"},
     {"[ ], Shift+[ ]", "brush size, opacity"},
@@ -388,6 +388,8 @@ static void toggle_fullscreen(vw_viewer *v)
     }
 }
 
+static bool at_full_quality(const vw_viewer *v);
+
 static bool next_screenshot_name(vw_viewer *v, char *out, size_t n)
 {
     for (int i = 0; i < 10000; i++) {
@@ -453,7 +455,12 @@ static void key_action(vw_viewer *v, int key, int mods)
     case GLFW_KEY_MINUS:
     case GLFW_KEY_KP_SUBTRACT: zoom_at(v, 1 / ZOOM_STEP, (float)v->fb_w * 0.5f, (float)v->fb_h * 0.5f), mark_input(v); break;
     case GLFW_KEY_0:
-    case GLFW_KEY_HOME: reset_camera(v); break;
+    case GLFW_KEY_HOME:
+        // The whole view as the viewer started: camera and the light (the dial follows).
+        reset_camera(v);
+        v->view.key = v->cli->view.key;
+        dial_from_light(v);
+        break;
     default:
         if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && key - GLFW_KEY_1 < n) select_cosmetic(v, key - GLFW_KEY_1);
         break;
@@ -742,7 +749,8 @@ static double frame(vw_viewer *v, const char *script_shot, const float *script_r
     rs_ui_begin(v->scene_ui, v->fb_w, v->fb_h, v->ui_scale, &(rs_ui_input){.x = -1, .y = -1});
     vw_draw_picture(v, v->scene_ui);
     rs_ui_end(v->scene_ui);
-    if (v->want_face_shot && v->ren) {
+    // S saves the picture at full quality: while it is still refining (or being moved), the shot waits.
+    if (v->want_face_shot && at_full_quality(v)) {
         char name[64];
         if (next_screenshot_name(v, name, sizeof name)) vw_write_png(v, name, NULL, false);
         v->want_face_shot = false;
@@ -780,11 +788,15 @@ static rs_result poll_loader(vw_viewer *v, bool first, rs_error *err)
     return RS_OK;
 }
 
-static bool settled(const vw_viewer *v)
+// The picture on screen is the full-quality one and nothing is about to change it.
+static bool at_full_quality(const vw_viewer *v)
 {
     return v->ren && !v->load.running && !interacting(v) && v->rendered_full && !v->dirty_view && !v->dirty_makeup &&
            v->queue.count == 0;
 }
+
+// ... and no screenshot is waiting for it (scripts' `idle` and `quit` wait for S too).
+static bool settled(const vw_viewer *v) { return at_full_quality(v) && !v->want_face_shot; }
 
 static int cmp_double(const void *a, const void *b)
 {

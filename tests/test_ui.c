@@ -267,6 +267,34 @@ static void test_captures_routes_presses_on_panels_to_the_ui(void)
     rs_ui_destroy(ui);
 }
 
+// A drag moves by what the pointer moved since the press: the pointer hovering 300 px away the frame
+// before (or a new touch landing there) must not add that jump (the split divider once went 200+ px left
+// for an 88 px drag to the right).
+static void test_drag_counts_from_the_press_not_the_hover(void)
+{
+    rs_ui *ui = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_ui_create(&ui, &err) == RS_OK, "%s", err.msg);
+    rs_ui_rect handle = {380, 280, 40, 40};
+    const rs_ui_input seq[] = {
+        {.x = 100, .y = 500, .inside = true},                       // hovering far away
+        {.x = 400, .y = 300, .down = true, .pressed = true},        // a touch lands on the handle
+        {.x = 444, .y = 300, .down = true},
+        {.x = 488, .y = 302, .down = true},
+        {.x = 488, .y = 302, .released = true},
+    };
+    float total = 0;
+    for (size_t i = 0; i < RS_COUNT_OF(seq); i++) {
+        float dx = 0, dy = 0;
+        rs_ui_begin(ui, 800, 600, 1, &seq[i]);
+        if (rs_ui_drag(ui, 3001, handle, &dx, &dy)) total += dx;
+        rs_ui_end(ui);
+        handle.x += dx;  // the widget follows, as the divider does
+    }
+    RS_CHECK(fabsf(total - 88.0f) < 0.5f, "dragged 88 px right, moved %g px", total);
+    rs_ui_destroy(ui);
+}
+
 static void test_slider_follows_the_pointer_and_clamps(void)
 {
     rs_ui *ui = NULL;
@@ -393,6 +421,7 @@ int main(int argc, char **argv)
     RS_RUN(test_text_renders_the_glyph_bits_exactly);
     RS_RUN(test_button_taps_only_when_pressed_and_released_on_it);
     RS_RUN(test_captures_routes_presses_on_panels_to_the_ui);
+    RS_RUN(test_drag_counts_from_the_press_not_the_hover);
     RS_RUN(test_slider_follows_the_pointer_and_clamps);
     RS_RUN(test_toolbar_render_matches_golden);
     RS_RUN(test_toolbar_render_at_2x_is_the_1x_layout_doubled);

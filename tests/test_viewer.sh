@@ -26,7 +26,8 @@ selected() {
 tests="viewer_script_stroke_changes_only_the_painted_area viewer_undo_restores_the_picture_exactly
 viewer_look_saved_and_loaded_renders_the_same viewer_records_a_replayable_stroke_file
 viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_one_line
-viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face"
+viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
+viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -234,5 +235,55 @@ if selected viewer_bad_dropped_file_keeps_the_face; then
     elif [ ! -f "$out/dafter_face.png" ]; then echo "FAIL - $name: no screenshot"
     elif why=$(region_same dbefore dafter face); then echo "ok - $name"
     else echo "FAIL - $name: the face changed after a bad drop: $why"; fi
+fi
+if selected viewer_key_0_resets_camera_and_light; then
+    # The sun dial sits at (726, 86) 56x56 on an 800x600 window (rs_ui_toolbar_layout_compute, scale 1):
+    # a tap in its upper-left moves the light, arrows orbit; `0` must bring back the picture as it started.
+    name=viewer_key_0_resets_camera_and_light
+    {
+        echo "key i"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $out/r0before_face.png 80 80 630 330"
+        echo "click 734 96"
+        echo "key left"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $out/r0moved_face.png 80 80 630 330"
+        echo "key 0"
+        echo "idle"
+        echo "screenshot $out/r0after_face.png 80 80 630 330"
+        echo "quit"
+    } >"$out/reset.events"
+    view --events "$out/reset.events" >"$out/reset.log" 2>&1
+    rc=$?
+    if [ $rc -ne 0 ] || [ ! -f "$out/r0after_face.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/reset.log")"
+    elif "$imgdiff" "$out/r0before_face.png" "$out/r0moved_face.png" --threshold 8 | awk '/^frac_over/ {exit !($2 < 0.05)}'; then
+        echo "FAIL - $name: the dial tap and the orbit did not change the picture"
+    elif why=$(region_same r0before r0after face); then echo "ok - $name"
+    else echo "FAIL - $name: after 0 the picture differs from the start: $why"; fi
+fi
+if selected viewer_s_saves_at_full_quality; then
+    # S pressed right after an orbit (the picture still coarse) must save the same picture as S pressed once
+    # it has refined: the shot waits for full quality. Each run in its own folder (S writes ./rouge-NNNN.png).
+    name=viewer_s_saves_at_full_quality
+    abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
+    abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
+    abs_out=$(cd "$out" && pwd)
+    for run in early late; do
+        rm -rf "$out/s_$run" && mkdir -p "$out/s_$run"
+        # An orbit drag in view mode (the ladder coarsens while it lasts), then S at once or after refining.
+        if [ $run = early ]; then printf 'key p\nidle\ndrag 300 300 380 300 10\nkey s\nmove 400 580\nidle\nquit\n'
+        else printf 'key p\nidle\ndrag 300 300 380 300 10\nmove 400 580\nidle\nkey s\nidle\nquit\n'; fi >"$out/s_$run.events"
+        (cd "$out/s_$run" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+            --events "$abs_out/s_$run.events" >"$abs_out/s_$run.log" 2>&1)
+    done
+    if [ ! -f "$out/s_early/rouge-0001.png" ] || [ ! -f "$out/s_late/rouge-0001.png" ]; then
+        echo "FAIL - $name: no screenshot written ($(tail -c 200 "$out/s_early.log"))"
+    else
+        m=$("$imgdiff" "$out/s_early/rouge-0001.png" "$out/s_late/rouge-0001.png" 2>&1 | awk '/^max_abs/ {print $2}')
+        if [ -n "$m" ] && [ "$m" -le 2 ]; then echo "ok - $name"
+        else echo "FAIL - $name: the early shot differs from the refined one (max_abs ${m:-error})"; fi
+    fi
 fi
 exit 0
