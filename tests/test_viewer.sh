@@ -27,7 +27,7 @@ tests="viewer_script_stroke_changes_only_the_painted_area viewer_undo_restores_t
 viewer_look_saved_and_loaded_renders_the_same viewer_records_a_replayable_stroke_file
 viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_one_line
 viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
-viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality"
+viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -42,7 +42,7 @@ d=91
 while [ -e "/tmp/.X$d-lock" ] || [ -e "/tmp/.X11-unix/X$d" ]; do d=$((d + 1)); done
 Xvfb ":$d" -screen 0 1024x768x24 -nolisten tcp >"$out/xvfb.log" 2>&1 &
 xvfb=$!
-trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null' EXIT INT TERM
+trap 'kill $xvfb 2>/dev/null; wait $xvfb 2>/dev/null; umount "$out/full" 2>/dev/null' EXIT INT TERM
 i=0
 while [ ! -e "/tmp/.X11-unix/X$d" ] && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1)); done
 [ -e "/tmp/.X11-unix/X$d" ] || skip_all "Xvfb :$d did not start ($(head -c 200 "$out/xvfb.log"))"
@@ -284,6 +284,27 @@ if selected viewer_s_saves_at_full_quality; then
         m=$("$imgdiff" "$out/s_early/rouge-0001.png" "$out/s_late/rouge-0001.png" 2>&1 | awk '/^max_abs/ {print $2}')
         if [ -n "$m" ] && [ "$m" -le 2 ]; then echo "ok - $name"
         else echo "FAIL - $name: the early shot differs from the refined one (max_abs ${m:-error})"; fi
+    fi
+fi
+if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
+    # A stroke recording (--record) onto a full disk: the viewer says so and the old recording survives.
+    name=viewer_recording_on_a_full_disk_keeps_the_old_file
+    mkdir -p "$out/full"
+    if mount -t tmpfs -o size=64k tmpfs "$out/full" 2>/dev/null; then
+        printf 'old recording' >"$out/full/rec.strokes"
+        dd if=/dev/zero of="$out/full/filler" bs=1k count=64 >/dev/null 2>&1
+        printf 'key i\nkey p\nkey 9\nidle\ndrag 370 150 430 150 10\nidle\nquit\n' >"$out/full.events"
+        view --record "$out/full/rec.strokes" --events "$out/full.events" >"$out/full.log" 2>&1
+        rc=$?
+        left=$(ls "$out/full" | grep -c '\.tmp\.')
+        if [ "$(cat "$out/full/rec.strokes")" != "old recording" ] || [ "$left" != 0 ]; then
+            echo "FAIL - $name: old recording lost or temp files left ($left)"
+        elif [ $rc -eq 0 ] || ! grep -q "No space left on device" "$out/full.log"; then
+            echo "FAIL - $name: exit $rc, no clear error: $(tail -c 300 "$out/full.log")"
+        else echo "ok - $name"; fi
+        umount "$out/full"
+    else
+        echo "skip - $name: cannot mount a tmpfs here (needs root)"
     fi
 fi
 exit 0
