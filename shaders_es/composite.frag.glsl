@@ -46,7 +46,7 @@ out vec4 o_color;
 vec3 linear_to_srgb(vec3 c)
 {
     c = clamp(c, 0.0, 1.0);
-    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+    return mix(1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, c * 12.92, step(c, vec3(0.0031308)));  // linear at and below
 }
 
 // Image-space hole filling: a pixel that no disk covered while at least 6 of its 8 neighbours are covered

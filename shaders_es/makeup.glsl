@@ -17,7 +17,7 @@ vec3 rs_makeup_srgb_to_linear(vec3 c)
 {
     vec3 lo = c / 12.92;
     vec3 hi = pow((c + 0.055) / 1.055, vec3(2.4));
-    return mix(hi, lo, vec3(lessThan(c, vec3(0.04045))));
+    return mix(hi, lo, vec3(lessThanEqual(c, vec3(0.04045))));  // IEC 61966-2-1: linear at and below
 }
 
 void rs_makeup_apply(uvec2 rec, inout vec3 albedo_lin, inout float m, inout float rho_s)

@@ -32,7 +32,7 @@ vec3 rs_decode_normal(uint code)
 
 vec3 rs_srgb_to_linear(vec3 c)
 {
-    return mix(c / 12.92, pow((c + 0.055) / 1.055, vec3(2.4)), step(vec3(0.04045), c));
+    return mix(pow((c + 0.055) / 1.055, vec3(2.4)), c / 12.92, step(c, vec3(0.04045)));  // linear at and below
 }
 
 rs_splat rs_decode_splat(uvec4 w)

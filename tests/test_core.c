@@ -1,6 +1,7 @@
 // test_core.c — the core helpers (src/core/core.c): terminal-safe text for messages that quote files.
 #include "support/harness.h"
 
+#include <math.h>
 #include <string.h>
 
 static const char *clean(const char *in, size_t cap)
@@ -42,6 +43,20 @@ static void test_errors_are_sanitised(void)
     RS_CHECK(!strcmp(err.msg, "unknown keyword '\\x1b]0;pwned\\x07'"), "%s", err.msg);
 }
 
+// One sRGB transfer function for the CPU (makeup, composite background, image metrics once had three that
+// disagreed on < vs <= at the threshold): linear at and below it, as IEC 61966-2-1 says, continuous there.
+static void test_srgb_threshold_and_round_trip(void)
+{
+    RS_CHECK(rs_srgb_to_linear(0.04045f) == 0.04045f / 12.92f, "at the threshold: %.9g", rs_srgb_to_linear(0.04045f));
+    RS_CHECK(rs_linear_to_srgb(0.0031308f) == 0.0031308f * 12.92f, "at the threshold: %.9g", rs_linear_to_srgb(0.0031308f));
+    float above = rs_srgb_to_linear(0.04045f + 1e-6f), at = rs_srgb_to_linear(0.04045f);
+    RS_CHECK(fabsf(above - at) < 1e-6f, "a step at the threshold: %.9g vs %.9g", at, above);
+    float worst = 0;
+    for (int q = 0; q < 256; q++) worst = fmaxf(worst, fabsf(rs_linear_to_srgb(rs_srgb_to_linear(q / 255.0f)) - q / 255.0f));
+    RS_CHECK(worst < 1e-5f, "8-bit round trip off by %g", worst);
+    RS_CHECK(rs_linear_to_srgb(-1) == 0 && fabsf(rs_linear_to_srgb(2) - 1.0f) < 1e-6f, "not clamped");
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -50,5 +65,6 @@ int main(int argc, char **argv)
     RS_RUN(test_sanitize_keeps_text_and_escapes_invalid_utf8);
     RS_RUN(test_sanitize_cuts_whole_characters);
     RS_RUN(test_errors_are_sanitised);
+    RS_RUN(test_srgb_threshold_and_round_trip);
     return rs_test_finish();
 }

@@ -179,7 +179,7 @@ static void test_look_made_on_full_cloud_loads_on_lod_prefix(void)
         // Same splat (same position) in both clouds: compose the makeup over the same base.
         float a[3], b[3], ma = 0.27f, mb = 0.27f, ra = 0.23f, rb = 0.23f;
         uint32_t w = full->packed[i].w[3];
-        for (int ch = 0; ch < 3; ch++) a[ch] = b[ch] = rs_makeup_srgb_to_linear(((w >> (8 * ch)) & 255u) / 255.0f);
+        for (int ch = 0; ch < 3; ch++) a[ch] = b[ch] = rs_srgb_to_linear(((w >> (8 * ch)) & 255u) / 255.0f);
         rs_makeup_apply_cpu(&rs_makeup_records(mk)[i], &ua, a, &ma, &ra);
         rs_makeup_apply_cpu(&rs_makeup_records(small)[i], &ub, b, &mb, &rb);
         for (int ch = 0; ch < 3; ch++) worst = fmaxf(worst, fabsf(a[ch] - b[ch]));

@@ -128,7 +128,7 @@ static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.
 static void base_albedo(const rs_splat_cloud *c, uint32_t i, float out[3])
 {
     uint32_t w = c->packed[i].w[3];
-    for (int ch = 0; ch < 3; ch++) out[ch] = rs_makeup_srgb_to_linear(((w >> (8 * ch)) & 255u) / 255.0f);
+    for (int ch = 0; ch < 3; ch++) out[ch] = rs_srgb_to_linear(((w >> (8 * ch)) & 255u) / 255.0f);
 }
 
 // ---------------------------------------------------------------------------------------------------
@@ -172,7 +172,7 @@ static void test_eq2_blend_is_linear_and_zero_record_is_base(void)
     rs_makeup_gpu full = {{255, 0, 128}, 255, 0, 0, 0, 128};
     memcpy(c, base, sizeof c);
     rs_makeup_apply_cpu(&full, &u, c, &m, &rho);
-    RS_CHECK(fabsf(c[0] - 1.0f) < 1e-6f && c[1] == 0.0f && fabsf(c[2] - rs_makeup_srgb_to_linear(128 / 255.0f)) < 1e-6f,
+    RS_CHECK(fabsf(c[0] - 1.0f) < 1e-6f && c[1] == 0.0f && fabsf(c[2] - rs_srgb_to_linear(128 / 255.0f)) < 1e-6f,
              "I = 1 gives Cp: %g %g %g", c[0], c[1], c[2]);
     // Half intensity: the midpoint in linear light (eq. 2), not in sRGB.
     rs_makeup_gpu half = full;
@@ -193,7 +193,7 @@ static void test_eq2_blend_is_linear_and_zero_record_is_base(void)
     dark.rgb[0] = 128;
     memcpy(c, base, sizeof c);
     rs_makeup_apply_cpu(&dark, &u, c, &m, &rho);
-    RS_CHECK(fabsf(c[0] - 0.5f * rs_makeup_srgb_to_linear(128 / 255.0f)) < 1e-6f, "detail modulates: %g", c[0]);
+    RS_CHECK(fabsf(c[0] - 0.5f * rs_srgb_to_linear(128 / 255.0f)) < 1e-6f, "detail modulates: %g", c[0]);
 }
 
 static void test_composition_of_two_products_equals_sequential_blends(void)

@@ -312,7 +312,7 @@ static void path_centroid(const rs_strokes *doc, double c[2])
 static double luminance(const uint8_t *p)
 {
     double c[3];
-    for (int k = 0; k < 3; k++) c[k] = rs_makeup_srgb_to_linear(p[k] / 255.0f);
+    for (int k = 0; k < 3; k++) c[k] = rs_srgb_to_linear(p[k] / 255.0f);
     return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 }
 

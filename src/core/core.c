@@ -6,6 +6,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <math.h>
 #include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -266,6 +267,17 @@ rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, r
         close(dfd);
     }
     return RS_OK;
+}
+
+float rs_srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+float rs_linear_to_srgb(float c)
+{
+    c = c > 0.0f ? (c < 1.0f ? c : 1.0f) : 0.0f;
+    return c <= 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
 double rs_time_now(void)

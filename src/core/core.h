@@ -38,6 +38,11 @@ rs_result rs_fail(rs_error *err, rs_result code, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 const char *rs_result_name(rs_result r);
 
+// The sRGB transfer function (IEC 61966-2-1), c in 0..1: linear below and at the 0.04045 / 0.0031308
+// thresholds. The one CPU copy (shaders_es/*.glsl use the same thresholds on the GPU).
+float rs_srgb_to_linear(float c);
+float rs_linear_to_srgb(float c);  // c clamped to 0..1
+
 // Copies `src` (len bytes) into dst (cap bytes, always NUL-terminated, cut at a character boundary) so
 // that a terminal shows it as text: control bytes (C0, DEL), C1 controls, bidirectional overrides and
 // isolates (U+202A-202E, U+2066-2069, U+200E/F) and bytes that are not UTF-8 become \xNN or \u{XXXX}.

@@ -277,12 +277,7 @@ rs_result rs_image_write_png(const char *path, const rs_image *img, rs_error *er
 // ---------------------------------------------------------------------------------------------------
 // Colour: sRGB -> CIELAB and CIEDE2000
 
-static double srgb8_to_linear(uint8_t v)
-{
-    // IEC 61966-2-1 sRGB transfer function.
-    double c = v / 255.0;
-    return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4);
-}
+static double srgb8_to_linear(uint8_t v) { return rs_srgb_to_linear(v / 255.0f); }
 
 static double lab_f(double t)
 {

@@ -167,17 +167,6 @@ static void build_bands(rs_makeup *mk)
     for (uint32_t b = 0; b < mk->band_count; b++) mk->band_end[b] = ok ? h->lods[h->lod_count - 1 - b] : mk->n;
 }
 
-float rs_makeup_srgb_to_linear(float c)
-{
-    return c < 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
-}
-
-float rs_makeup_linear_to_srgb(float c)
-{
-    c = clamp01(c);
-    return c < 0.0031308f ? c * 12.92f : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
-}
-
 float rs_makeup_brush_radius(const rs_splat_header *hdr, float size_rel)
 {
     // Size is the DIAMETER as a fraction of the face height: the paper's Fig. 8 sizes 0.1 / 0.2 / 0.3
@@ -250,8 +239,8 @@ float rs_makeup_intensity(float i_g, float i_m, float i_f)
 
 static void build_tables(colour_tables *t)
 {
-    for (int q = 0; q < 256; q++) t->to_lin[q] = rs_makeup_srgb_to_linear(q / 255.0f);
-    for (int q = 0; q < 255; q++) t->mid[q] = rs_makeup_srgb_to_linear((q + 0.5f) / 255.0f);
+    for (int q = 0; q < 256; q++) t->to_lin[q] = rs_srgb_to_linear(q / 255.0f);
+    for (int q = 0; q < 255; q++) t->mid[q] = rs_srgb_to_linear((q + 0.5f) / 255.0f);
 }
 
 // Nearest sRGB8 code of a linear value (round in the sRGB domain): binary search of the thresholds.
@@ -336,7 +325,7 @@ void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, 
     if (ci > 0.0f) {
         float detail = rec->flags / 128.0f;
         for (int ch = 0; ch < 3; ch++) {
-            float cp = rs_makeup_srgb_to_linear(rec->rgb[ch] / 255.0f);
+            float cp = rs_srgb_to_linear(rec->rgb[ch] / 255.0f);
             float pig = RS_MIN(RS_CLAMP(cp, u->range_lo[ch], u->range_hi[ch]) * detail, 1.0f);
             albedo_lin[ch] = albedo_lin[ch] * (1.0f - ci) + pig * ci;  // eq. (2)
         }

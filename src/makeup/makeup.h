@@ -176,7 +176,5 @@ void rs_makeup_erase(rs_makeup_gpu *rec, float amount);
 // CPU mirror of rs_makeup_apply in shaders_es/makeup.glsl (same operations, same order).
 void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, float albedo_lin[3], float *m,
                          float *rho_s);
-float rs_makeup_srgb_to_linear(float c);  // c in 0..1
-float rs_makeup_linear_to_srgb(float c);
 
 #endif

@@ -7,11 +7,6 @@
 
 #include <math.h>
 
-static float srgb_to_linear(float c)
-{
-    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
-}
-
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
 {
     GLuint prog;
@@ -37,7 +32,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     float bg[3];
     for (int c = 0; c < 3; c++) {
         float b = RS_CLAMP(v->background[c], 0.0f, 1.0f);
-        bg[c] = v->linear_output ? srgb_to_linear(b) : b;
+        bg[c] = v->linear_output ? rs_srgb_to_linear(b) : b;
     }
     glUniform3fv(rs_uloc(prog, "u_background"), 1, bg);
     glUniform1f(rs_uloc(prog, "u_rho_s_scale"), v->rho_s_scale);
