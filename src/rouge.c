@@ -314,7 +314,9 @@ rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, ro
     float side[3] = {h->up[1] * h->forward[2] - h->up[2] * h->forward[1],
                      h->up[2] * h->forward[0] - h->up[0] * h->forward[2],
                      h->up[0] * h->forward[1] - h->up[1] * h->forward[0]};
-    double sum[2][3] = {{0}}, facing[2] = {0};
+    // One pass: per half, the count, the sums of positions and squared lengths (centre and spread follow)
+    // and how squarely it faces the camera.
+    double sum[2][3] = {{0}}, sq[2] = {0}, facing[2] = {0};
     uint32_t n[2] = {0}, middle = 0;
     for (uint32_t i = 0; i < h->count; i++) {
         if ((int)(f->cloud->packed[i].w[1] >> 24) != idx) continue;
@@ -327,6 +329,7 @@ rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, ro
         int s = sd >= 0;
         middle += fabsf(sd) < 0.05f * h->face_height;
         for (int a = 0; a < 3; a++) sum[s][a] += p[a];
+        sq[s] += (double)p[0] * p[0] + (double)p[1] * p[1] + (double)p[2] * p[2];
         facing[s] += d;
         n[s]++;
     }
@@ -336,25 +339,19 @@ rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, ro
         rs_fail(&e, RS_ERR_ARG, "target: region '%s' does not face the camera from this view", region);
         return fail_out(err, &e);
     }
-    int pick = -1;  // -1: both halves together
     uint32_t all = n[0] + n[1];
     // Two-sided when the region has (almost) nothing near the mid-plane: cheeks, not lips or nose.
-    if (n[0] > all / 4 && n[1] > all / 4 && middle < all / 20) pick = facing[1] / n[1] > facing[0] / n[0] ? 1 : 0;
-    double c[3] = {0};
-    uint32_t cn = pick < 0 ? all : n[pick];
-    for (int a = 0; a < 3; a++) c[a] = (pick < 0 ? sum[0][a] + sum[1][a] : sum[pick][a]) / cn;
-    // Size: twice the RMS distance of those splats from their centre.
-    double ss = 0;
-    for (uint32_t i = 0; i < h->count; i++) {
-        if ((int)(f->cloud->packed[i].w[1] >> 24) != idx) continue;
-        const float *p = f->cloud->pos[i], *nrm = f->cloud->normal[i];
-        int s = ((p[0] - h->centre[0]) * side[0] + (p[1] - h->centre[1]) * side[1] + (p[2] - h->centre[2]) * side[2]) >= 0;
-        if (pick >= 0 && s != pick) continue;
-        float dir[3];
-        rs_render_view_dir(f->ren, &v, p, dir);
-        if (nrm[0] * dir[0] + nrm[1] * dir[1] + nrm[2] * dir[2] < 0.2f) continue;
-        ss += (p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]);
+    bool halves = n[0] > all / 4 && n[1] > all / 4 && middle < all / 20;
+    int lo = 0, hi = 1;
+    if (halves) lo = hi = facing[1] / n[1] > facing[0] / n[0] ? 1 : 0;
+    double c[3] = {0}, q = 0, cn = 0;
+    for (int k = lo; k <= hi; k++) {
+        for (int a = 0; a < 3; a++) c[a] += sum[k][a];
+        q += sq[k], cn += n[k];
     }
+    for (int a = 0; a < 3; a++) c[a] /= cn;
+    // Size: twice the RMS distance of those splats from their centre.
+    double ss = fmax(q - cn * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), 0.0);
     double size = 2.0 * sqrt(ss / (double)cn);
     // Zoom moves the camera along its ray towards the face centre (render.c: distance = 0.625 H /
     // tan(fov/2) / zoom). Put it where the region, d_r in front of the centre, spans `fill` of the view.
