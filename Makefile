@@ -11,6 +11,7 @@
 #   tests/test_*                         one test program per tests/test_*.c
 
 BUILD    ?= build
+PREFIX   ?= /usr/local
 PKGS     := egl glesv2 glfw3 libpng cglm
 CC       ?= cc
 OPT      ?= -O2
@@ -33,7 +34,7 @@ APP_OBJ  := $(APP_SRC:%.c=$(BUILD)/obj/%.o)
 APPLIB_OBJ := $(filter-out $(BUILD)/obj/app/main.o,$(APP_OBJ))
 TLIB_OBJ := $(TOOL_LIB:%.c=$(BUILD)/obj/%.o)
 TESTS    := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
-PROGS    := $(BUILD)/rouge $(TOOL_PROG:tools/rouge_%.c=$(BUILD)/rouge-%)
+PROGS    := $(BUILD)/rouge $(TOOL_PROG:tools/rouge_%.c=$(BUILD)/rouge-%) $(BUILD)/rouge-env
 
 # The library needs no window system: GLFW is the app's.
 LIB_PKGS := egl glesv2 libpng cglm
@@ -48,7 +49,7 @@ SOMAJOR  := 0
 SONAME   := librouge.so.$(SOMAJOR)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 
-.PHONY: all deps run test bench asan fuzz figures clean install uninstall
+.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall
 all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES)
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
@@ -58,7 +59,7 @@ deps:
 # Include paths say who may use what: the library sees only src/; the app adds app/, the tools tools/.
 $(BUILD)/obj/src/%.o: src/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -fPIC -Iinclude -Isrc -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) -fPIC -Iinclude -Isrc -DRS_DATADIR='"$(PREFIX)/share/rouge"' -c $< -o $@
 
 $(BUILD)/obj/app/%.o: app/%.c
 	@mkdir -p $(dir $@)
@@ -114,6 +115,15 @@ $(BUILD)/rouge: $(APP_OBJ) $(BUILD)/librouge.a
 $(BUILD)/rouge-pack: $(BUILD)/obj/tools/rouge_pack.o $(BUILD)/libpack.a $(BUILD)/librouge.a
 	$(CC) $(CFLAGS) $< $(BUILD)/libpack.a $(LIBS) $(LDFLAGS) -o $@
 
+# rouge-env (tools-time only) reads OpenEXR through the C++ library (tools/env/exr_read.cpp: OpenEXR 3.1's
+# C core cannot decode DWA, which blender-data's HDRIs use), so it links with the C++ compiler.
+CXX ?= c++
+$(BUILD)/obj/tools/env/exr_read.o: tools/env/exr_read.cpp tools/env/exr_read.h
+	@mkdir -p $(dir $@)
+	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror $(EXTRA_CFLAGS) $(shell pkg-config --cflags OpenEXR) -c $< -o $@
+$(BUILD)/rouge-env: $(BUILD)/obj/tools/env/rouge_env.o $(BUILD)/obj/tools/env/exr_read.o $(BUILD)/librouge.a
+	$(CXX) $(OPT) -g $(EXTRA_CFLAGS) $^ $(PKG_LIBS) $(shell pkg-config --libs OpenEXR) -lm $(LDFLAGS) -o $@
+
 $(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a
 	$(CC) $(CFLAGS) $< $(LIBS) $(LDFLAGS) -o $@
 
@@ -151,8 +161,8 @@ fuzz: deps
 	@sh tools/fuzz.sh
 
 # make install [PREFIX=/usr/local] [DESTDIR=]: the header, both libraries, rouge.pc, the programs and
-# the bundled face they open by default (share/rouge; the programs look there next to their bin/).
-PREFIX ?= /usr/local
+# the bundled face and environments they open by default (share/rouge; the programs look there next to
+# their bin/, the library in $(PREFIX)/share/rouge as it was built: build with the PREFIX you install to).
 INSTALL_PROGS := $(BUILD)/rouge $(BUILD)/rouge-pack $(BUILD)/rouge-imgdiff $(BUILD)/rouge-profile
 I := $(DESTDIR)$(PREFIX)
 install: $(INSTALL_PROGS) $(BUILD)/librouge.a $(BUILD)/$(SONAME)
@@ -168,12 +178,23 @@ install: $(INSTALL_PROGS) $(BUILD)/librouge.a $(BUILD)/$(SONAME)
 	    'Version: $(VERSION)' 'Requires.private: $(LIB_PKGS)' 'Libs: -L$${libdir} -lrouge' 'Libs.private: -lm' \
 	    'Cflags: -I$${includedir}' > $(I)/lib/pkgconfig/rouge.pc
 	install -m 644 assets/face.rsf assets/README.md $(I)/share/rouge/
+	install -d $(I)/share/rouge/env
+	install -m 644 assets/env/*.rse assets/env/README.md $(I)/share/rouge/env/
 
 uninstall:
 	rm -f $(addprefix $(I)/bin/,$(notdir $(INSTALL_PROGS))) $(I)/include/rouge.h $(I)/lib/librouge.a
 	rm -f $(I)/lib/$(SONAME).* $(I)/lib/$(SONAME) $(I)/lib/librouge.so $(I)/lib/pkgconfig/rouge.pc
-	rm -f $(I)/share/rouge/face.rsf $(I)/share/rouge/README.md
-	-rmdir $(I)/share/rouge 2>/dev/null
+	rm -f $(I)/share/rouge/face.rsf $(I)/share/rouge/README.md $(I)/share/rouge/env/*.rse $(I)/share/rouge/env/README.md
+	-rmdir $(I)/share/rouge/env $(I)/share/rouge 2>/dev/null
+
+# The bundled lighting environments from blender-data's CC0 HDRIs (assets/env/README.md).
+ENV_SRC := /usr/share/blender/datafiles/studiolights/world
+ENV_NOTE = Source: Blender studiolights world/$(2).exr (Debian blender-data), by Greg Zaal (HDRI Haven), CC0 1.0
+envs: deps $(BUILD)/rouge-env
+	$(BUILD)/rouge-env $(ENV_SRC)/studio.exr -o assets/env/studio.rse --name studio --notes "$(call ENV_NOTE,,studio)"
+	$(BUILD)/rouge-env $(ENV_SRC)/courtyard.exr -o assets/env/daylight.rse --name daylight --notes "$(call ENV_NOTE,,courtyard)"
+	$(BUILD)/rouge-env $(ENV_SRC)/interior.exr -o assets/env/office.rse --name office --notes "$(call ENV_NOTE,,interior)"
+	$(BUILD)/rouge-env $(ENV_SRC)/sunset.exr -o assets/env/sunset.rse --name sunset --notes "$(call ENV_NOTE,,sunset)"
 
 clean:
 	rm -rf build build-*

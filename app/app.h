@@ -18,7 +18,10 @@ const char *rs_app_default_face(char *buf, size_t n);
 // Headless: load the face, apply --look / --strokes, render the view to cli->output (atomic PNG write).
 rs_result rs_app_render(const rs_cli *cli, rs_error *err);
 // The command line's view (every field explicit) as the public API's view.
-rouge_view rs_app_public_view(const rs_view *v);
+rouge_view rs_app_public_view(const rs_view *v, const char *env);
+// The environments' directory next to the program: <bin>/../share/rouge/env when installed, else
+// <bin>/../assets/env (a source tree's build/); NULL if neither.
+const char *rs_app_env_dir(char *buf, size_t n);
 // A public API failure as the app's error (same codes, same message); returns the code.
 rs_result rs_app_error(rouge_result r, const rouge_error *e, rs_error *err);
 // The GLFW viewer (viewer.c).

@@ -27,21 +27,23 @@ static const opt opts[] = {
     {"--pan", OPT_PAN, "X,Y", "shift the picture by X,Y view heights (+x right, +y down; -2..2)", -RS_VIEW_PAN_MAX, RS_VIEW_PAN_MAX},
     {"--target", OPT_PATH, "REGION", "centre and zoom on a region of the face (lips, nose, cheek, forehead, ...)", 0, 0},
     {"--fov", OPT_FLOAT, "DEG", "vertical field of view (default 30; 1..150)", RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG},
-    {"--light-yaw", OPT_FLOAT, "DEG", "key light direction, yaw", -360, 360},
-    {"--light-pitch", OPT_FLOAT, "DEG", "key light direction, pitch (+ = from above)", -90, 90},
+    {"--env", OPT_PATH, "NAME", "lighting: " RS_ENV_NAME_LIST " (default " RS_ENV_DEFAULT "), or a .rse file", 0, 0},
+    {"--env-rotate", OPT_FLOAT, "DEG", "turn the environment about the face's up axis (+ moves its light like +yaw)", -360, 360},
+    {"--light-yaw", OPT_FLOAT, "DEG", "key light direction, yaw (--env paper)", -360, 360},
+    {"--light-pitch", OPT_FLOAT, "DEG", "key light direction, pitch (+ = from above; --env paper)", -90, 90},
     {"--light-color", OPT_RGB, "R,G,B", "key light colour, linear 0..10", 0, 10},
     {"--light-intensity", OPT_FLOAT, "X", "key light intensity (default 1)", 0, 100},
-    {"--fill-yaw", OPT_FLOAT, "DEG", "fill light yaw (enables the fill light)", -360, 360},
+    {"--fill-yaw", OPT_FLOAT, "DEG", "fill light yaw (enables the fill light; --env paper)", -360, 360},
     {"--fill-pitch", OPT_FLOAT, "DEG", "fill light pitch", -90, 90},
     {"--fill-intensity", OPT_FLOAT, "X", "fill light intensity (0 = off)", 0, 100},
     {"--mode", OPT_ENUM, "MODE", "full|albedo|diffuse|specular|normals|regions|shadow|lod|irradiance", 0, 0},
     {"--pipeline", OPT_ENUM, "P", "reference|mobile (render default: reference; viewer default: mobile)", 0, 0},
-    {"--composite", OPT_ENUM, "C", "paper: F = A(D+S) (default) | physical: F = A D + S", 0, 0},
-    {"--exposure", OPT_FLOAT, "X", "linear exposure before sRGB encoding (default 1)", 0.01f, 100},
+    {"--composite", OPT_ENUM, "C", "default (paper with --env paper, else physical) | paper: F = A(D+S) | physical: F = A D + S", 0, 0},
+    {"--exposure", OPT_FLOAT, "X", "linear exposure before the filmic curve and sRGB (default 1)", 0.01f, 100},
     {"--background", OPT_RGB, "R,G,B", "background colour, sRGB 0..1", 0, 1},
     {"--no-shadows", OPT_FLAG, NULL, "disable the shadow map", 0, 0},
     {"--specular-scale", OPT_FLOAT, "X", "multiply every rho_s (1 = Weyrich's measured skin; 2 = oily skin)", 0.01f, 10},
-    {"--ambient", OPT_FLOAT, "X", "uniform sky light added to the irradiance (default 0.05)", 0, 10},
+    {"--ambient", OPT_FLOAT, "X", "uniform sky light added to the irradiance (--env paper; default 0.05)", 0, 10},
     {"--max-splats", OPT_INT, "N", "draw at most N splats (an LOD prefix)", 1, 2e9f},
     {"--kernels", OPT_INT, "K", "mobile pipeline: number of Gaussians (2..4, default 3)", 2, 4},
     {"--lod-density", OPT_FLOAT, "D", "mobile pipeline: visible splats per face pixel (default 0.3)", 0.01f, 1000},
@@ -83,6 +85,7 @@ static rs_result parse_enum(const char *name, const char *v, rs_cli *c, rs_error
         if (!strcmp(v, "reference")) return c->view.pipeline = RS_PIPELINE_REFERENCE, RS_OK;
         if (!strcmp(v, "mobile")) return c->view.pipeline = RS_PIPELINE_MOBILE, RS_OK;
     } else if (!strcmp(name, "--composite")) {
+        if (!strcmp(v, "default")) return c->view.composite = RS_COMPOSITE_DEFAULT, RS_OK;
         if (!strcmp(v, "paper")) return c->view.composite = RS_COMPOSITE_PAPER, RS_OK;
         if (!strcmp(v, "physical")) return c->view.composite = RS_COMPOSITE_PHYSICAL, RS_OK;
     } else if (!strcmp(name, "--prim")) {
@@ -164,6 +167,8 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--strokes")) c->strokes = v;
     else if (!strcmp(n, "--look")) c->look = v;
     else if (!strcmp(n, "--target")) c->target = v;
+    else if (!strcmp(n, "--env")) c->env = v;
+    else if (!strcmp(n, "--env-rotate")) w->env_rotate_deg = f;
     else if (!strcmp(n, "--save-look")) c->save_look = v;
     else if (!strcmp(n, "--record")) c->record = v;
     else if (!strcmp(n, "--fullscreen")) c->fullscreen = true;

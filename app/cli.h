@@ -7,6 +7,7 @@
 #ifndef RS_APP_CLI_H
 #define RS_APP_CLI_H
 
+#include "formats/env_lookup.h"
 #include "render/render.h"
 
 #include <stdio.h>
@@ -19,6 +20,7 @@ typedef struct rs_cli {
     const char *strokes;    // --strokes FILE: replay painting
     const char *look;       // --look FILE: apply a saved look
     const char *target;     // --target REGION: frame a region of the face
+    const char *env;        // --env NAME|FILE.rse (NULL: RS_ENV_DEFAULT; "paper": the key light)
     bool pan_set;           // --pan given (it then also shifts a --target or stroke file's framing)
     const char *save_look;  // --save-look FILE: save the look after replaying strokes
     const char *record;     // --record FILE: viewer records strokes

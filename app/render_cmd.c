@@ -9,24 +9,40 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+// <bin>/../share/rouge/NAME for the running program (what `make install` lays out); false if unknown.
+static bool installed_path(const char *name, char *buf, size_t n)
+{
+    char exe[512];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    if (len <= 0) return false;
+    exe[len] = 0;
+    char *slash = strrchr(exe, '/');
+    if (slash) *slash = 0;
+    snprintf(buf, n, "%s/../share/rouge/%s", exe, name);
+    return true;
+}
+
 const char *rs_app_default_face(char *buf, size_t n)
 {
     snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
     if (access(buf, R_OK) == 0) return buf;
-    char exe[512];
-    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (len <= 0) return buf;
-    exe[len] = 0;
-    char *slash = strrchr(exe, '/');
-    if (slash) *slash = 0;
-    snprintf(buf, n, "%s/../share/rouge/face.rsf", exe);
-    if (access(buf, R_OK) != 0) snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
+    if (!installed_path("face.rsf", buf, n) || access(buf, R_OK) != 0) snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
     return buf;
 }
 
-rouge_view rs_app_public_view(const rs_view *v)
+const char *rs_app_env_dir(char *buf, size_t n)
+{
+    if (!installed_path("env", buf, n)) return NULL;
+    if (access(buf, R_OK) == 0) return buf;
+    // A program run from a source tree's build directory, from anywhere: <tree>/build/../assets/env.
+    installed_path("../../assets/env", buf, n);
+    return access(buf, R_OK) == 0 ? buf : NULL;
+}
+
+rouge_view rs_app_public_view(const rs_view *v, const char *env)
 {
     rouge_view p = {
+        .env = env, .env_rotation_deg = v->env_rotate_deg,
         .width = v->width, .height = v->height, .yaw_deg = v->yaw_deg, .pitch_deg = v->pitch_deg,
         .zoom = v->zoom, .fov_deg = v->fov_deg, .pan = {v->pan[0], v->pan[1]},
         // A key light with intensity 0 is still "given" (not the default): rouge.h's zero rule.
@@ -37,7 +53,7 @@ rouge_view rs_app_public_view(const rs_view *v)
         .ambient = v->ambient > 0 ? v->ambient : -1.0f,
         .mode = (rouge_mode)v->mode,
         .pipeline = v->pipeline == RS_PIPELINE_MOBILE ? ROUGE_PIPELINE_MOBILE : ROUGE_PIPELINE_REFERENCE,
-        .composite = v->composite == RS_COMPOSITE_PHYSICAL ? ROUGE_COMPOSITE_PHYSICAL : ROUGE_COMPOSITE_PAPER,
+        .composite = (rouge_composite)v->composite,
         .exposure = v->exposure,
         .background = {v->background[0], v->background[1], v->background[2], 1.0f},
         .no_shadows = v->no_shadows, .hide_makeup = v->hide_makeup, .specular_scale = v->rho_s_scale,
@@ -60,7 +76,7 @@ static rouge_result paint(const rs_cli *cli, rouge_face *face, rouge_error *e)
     rouge_result r = ROUGE_OK;
     if (cli->look) r = rouge_face_load_look(face, cli->look, e);
     if (!r && cli->strokes) {
-        rouge_view cam = rouge_face_get_view(face), v = rs_app_public_view(&cli->view);
+        rouge_view cam = rouge_face_get_view(face), v = rs_app_public_view(&cli->view, cli->env);
         r = rouge_face_play_strokes(face, cli->strokes, e);
         cam = rouge_face_get_view(face);
         if (!cli->view_set[0]) v.yaw_deg = cam.yaw_deg;
@@ -99,8 +115,11 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
     if (rr) return rr;
     rouge_error e = {0};
     rouge_face *face = NULL;
-    rouge_view view = rs_app_public_view(&cli->view);
-    rouge_result r = rouge_face_create(&(rouge_face_desc){.path = path, .view = &view}, &face, &e);
+    rouge_view view = rs_app_public_view(&cli->view, cli->env);
+    char env_dir[600];
+    rouge_result r = rouge_face_create(
+        &(rouge_face_desc){.path = path, .view = &view, .env_dir = rs_app_env_dir(env_dir, sizeof env_dir)}, &face,
+        &e);
     if (!r) r = paint(cli, face, &e);
     if (!r && cli->target) {
         r = rouge_face_target(face, cli->target, 0, &e);

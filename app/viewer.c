@@ -45,7 +45,8 @@
 const vw_shortcut vw_shortcuts[] = {
     {"Left drag", "orbit; in paint mode: paint"},
     {"Right drag, scroll", "pan, zoom (touch: two fingers)"},
-    {"L+drag, sun dial", "move the light"},
+    {"L+drag, sun dial", "move the light (environments: turn them)"},
+    {"G, Shift+G, top chips", "next / previous lighting environment"},
     {"Arrows, +/-, 0", "orbit, zoom, reset camera and light"},
     {"P", "paint / view mode"},
     {"1-9, Tab", "pick a cosmetic; Tab: next"},
@@ -166,19 +167,67 @@ static void select_cosmetic(vw_viewer *v, int i)
     apply_brush(v);
 }
 
+static bool env_lit(const vw_viewer *v) { return v->view.lighting == RS_LIGHTING_ENV && v->env_cpu; }
+
+// Under an environment the dial turns the world around the face (its sideways position is the
+// rotation, a half turn at the rim); under `paper` it points the key light.
 static void light_from_dial(vw_viewer *v)
 {
-    v->view.key.yaw_deg = v->light_dial[0] * LIGHT_DIAL_DEG;
-    v->view.key.pitch_deg = v->light_dial[1] * LIGHT_DIAL_DEG;
+    if (env_lit(v)) {
+        v->view.env_rotate_deg = v->light_dial[0] * 180.0f;
+    } else {
+        v->view.key.yaw_deg = v->light_dial[0] * LIGHT_DIAL_DEG;
+        v->view.key.pitch_deg = v->light_dial[1] * LIGHT_DIAL_DEG;
+    }
     v->dirty_view = true;
 }
 
 static void dial_from_light(vw_viewer *v)
 {
+    if (env_lit(v)) {
+        v->light_dial[0] = RS_CLAMP(v->view.env_rotate_deg / 180.0f, -1.0f, 1.0f), v->light_dial[1] = 0;
+        return;
+    }
     float x = v->view.key.yaw_deg / LIGHT_DIAL_DEG, y = v->view.key.pitch_deg / LIGHT_DIAL_DEG;
     float d = sqrtf(x * x + y * y);
     if (d > 1) x /= d, y /= d;
     v->light_dial[0] = x, v->light_dial[1] = y;
+}
+
+// Switches the lighting to environment `name` (a bundled name, "paper" or a .rse file); on failure the
+// current one stays and a toast says why.
+bool vw_set_env(vw_viewer *v, const char *name)
+{
+    rs_error err = {0};
+    if (rs_env_is_paper(name)) {
+        v->view.lighting = RS_LIGHTING_LIGHTS;
+    } else {
+        rs_env *e = NULL;
+        if (rs_env_open(name, v->env_dir, &e, &err) != RS_OK ||
+            (v->ren && rs_render_set_env(v->ren, e, &err) != RS_OK)) {
+            rs_env_destroy(e);
+            // A failed upload leaves the renderer without one: put the previous environment back.
+            if (v->ren && v->env_cpu && !rs_render_has_env(v->ren)) rs_render_set_env(v->ren, v->env_cpu, NULL);
+            vw_toast(v, true, "%s", err.msg);
+            return false;
+        }
+        rs_env_destroy(v->env_cpu);
+        v->env_cpu = e;
+        v->view.lighting = RS_LIGHTING_ENV;
+    }
+    snprintf(v->env_name, sizeof v->env_name, "%s", name);
+    dial_from_light(v);
+    v->dirty_view = true;
+    return true;
+}
+
+static void next_env(vw_viewer *v, int step)
+{
+    int n = rs_env_name_count(), cur = 0;
+    for (int i = 0; i < n; i++)
+        if (strcmp(rs_env_name(i), v->env_name) == 0) cur = i;
+    for (int k = 1; k < n; k++)  // skips one that fails to load
+        if (vw_set_env(v, rs_env_name(((cur + step * k) % n + n) % n))) break;
 }
 
 static void reset_camera(vw_viewer *v)
@@ -309,6 +358,7 @@ static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path
     rs_makeup *mk = NULL;
     rs_paint *pt = NULL;
     rs_result r = rs_render_create(&(rs_render_desc){.cloud = cloud, .caps = rs_window_caps(v->window)}, &ren, err);
+    if (!r && v->env_cpu) r = rs_render_set_env(ren, v->env_cpu, err);
     if (!r) r = rs_makeup_create(cloud, NULL, &mk, err);
     if (!r) r = rs_paint_create(mk, &v->picker, &(rs_paint_desc){.input.mode = RS_INPUT_VIEW}, &pt, err);
     if (r) {
@@ -320,6 +370,10 @@ static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path
     }
     face_close(v);
     v->cloud = cloud, v->ren = ren, v->mk = mk, v->paint = pt;
+    // The pigment is clamped into this face's colour range, as `rouge render` does (rouge.c).
+    rs_makeup_uniforms mu;
+    rs_makeup_get_uniforms(mk, &mu);
+    rs_render_set_makeup_uniforms(ren, &mu);
     snprintf(v->face_path, sizeof v->face_path, "%s", path);
     apply_brush(v);
     if (v->rec) rs_paint_set_recorder(v->paint, v->rec, NULL);
@@ -459,8 +513,10 @@ static void key_action(vw_viewer *v, int key, int mods)
         // The whole view as the viewer started: camera and the light (the dial follows).
         reset_camera(v);
         v->view.key = v->cli->view.key;
+        v->view.env_rotate_deg = v->cli->view.env_rotate_deg;
         dial_from_light(v);
         break;
+    case GLFW_KEY_G: next_env(v, shift ? -1 : 1); break;
     default:
         if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && key - GLFW_KEY_1 < n) select_cosmetic(v, key - GLFW_KEY_1);
         break;
@@ -838,6 +894,9 @@ static rs_result run(vw_viewer *v, rs_error *err)
 {
     const rs_cli *c = v->cli;
     char def[600];
+    rs_app_env_dir(v->env_dir, sizeof v->env_dir);
+    if (!vw_set_env(v, c->env ? c->env : RS_ENV_DEFAULT))
+        return rs_fail(err, RS_ERR_ARG, "%s", v->toast);
     rs_result r = load_start(v, c->face ? c->face : rs_app_default_face(def, sizeof def), err);
     if (r) return r;
     // Loading screen until the face is there.
@@ -913,8 +972,6 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         v->picker = (rs_paint_picker){.user = v, .pick = vw_pick, .pixels_per_unit = vw_pixels_per_unit, .view_dir = view_dir_cb};
         v->view = cli->view;
         if (!o.pipeline_set) v->view.pipeline = RS_PIPELINE_MOBILE;
-        // A soft fill from the other side: makeup is judged in even light (the key light stays movable).
-        if (v->view.fill.intensity <= 0) v->view.fill.intensity = 0.4f;
         v->split_frac = 0.5f;
         v->render_scale = 1;
         v->hud = true;
@@ -937,6 +994,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
     }
     if (v->load.running) pthread_join(v->load.thread, NULL), rs_splat_destroy(v->load.cloud);
     face_close(v);
+    rs_env_destroy(v->env_cpu);
     rs_ui_texture_free(&v->before);
     rs_ui_destroy(v->ui);
     rs_ui_destroy(v->scene_ui);

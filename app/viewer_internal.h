@@ -184,6 +184,9 @@ typedef struct vw_viewer {
 
     // Camera, light and what is shown.
     rs_view view;
+    rs_env *env_cpu;            // the lighting environment (kept to upload into a newly opened face)
+    char env_name[600];         // its name as chosen (a bundled name, "paper" or a .rse path)
+    char env_dir[600];          // <bin>/../share/rouge/env
     float light_dial[2];
     bool split, hud, help, paint_mode;
     float split_frac;
@@ -242,6 +245,8 @@ extern const size_t vw_shortcut_count;
 // viewer.c
 double vw_now(void);
 void vw_toast(vw_viewer *v, bool error, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+// Lighting environment by name (bundled, "paper" or a .rse file); false (and a toast) when it cannot load.
+bool vw_set_env(vw_viewer *v, const char *name);
 float vw_size_to_slider(float size_rel);
 // The picker on the picture as shown: framebuffer pixels in, whatever resolution it was rendered at.
 bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index, float hit[3]);

@@ -118,8 +118,9 @@ typedef enum rouge_primitive {
 } rouge_primitive;
 
 typedef enum rouge_composite {
-    ROUGE_COMPOSITE_PAPER = 0,   // F = A (D + S)
-    ROUGE_COMPOSITE_PHYSICAL,    // F = A D + S
+    ROUGE_COMPOSITE_DEFAULT = 0, // PAPER with env "paper", PHYSICAL under an environment
+    ROUGE_COMPOSITE_PAPER,       // F = A (D + S): the paper's eq. 1, the highlight tinted by the skin
+    ROUGE_COMPOSITE_PHYSICAL,    // F = A D + S: a dielectric's white highlight
 } rouge_composite;
 
 // A directional light, given as the direction it comes FROM in the face's frame (0, 0: from the front,
@@ -136,15 +137,17 @@ typedef struct rouge_view {
     float zoom;                  // 0 = 1: the face height fills ~80% of the view height; 2 = twice as close
     float fov_deg;               // vertical field of view; 0 = 30
     float pan[2];                // screen shift, fractions of the view height (+x right, +y down)
+    const char *env;             // lighting: "studio" (NULL or "" = this), "daylight", "office", "sunset", a
+                                 // path to a .rse file (tools/env), or "paper": the key/fill/ambient below
+    float env_rotation_deg;      // environment turned about the face's up axis (+ moves its light like + yaw)
+    // Only with env "paper" (the paper's single lamp, no tone curve):
     rouge_light key;             // all zero = the default key light (yaw -35, pitch 30: upper left-front, white, 1)
     rouge_light fill;            // all zero = no fill light
     float ambient;               // uniform sky light; 0 = 0.05, negative = none
-    const char *env;             // lighting environment by name; NULL or "" = the key/fill lights above
-    float env_rotation_deg;      // environment turned about the face's up axis
     rouge_mode mode;
     rouge_pipeline pipeline;
     rouge_composite composite;
-    float exposure;              // linear multiplier before sRGB; 0 = 1
+    float exposure;              // linear multiplier before the filmic tone curve and sRGB; 0 = 1
     float background[4];         // sRGB 0..1 + alpha; alpha 0 = the default dark grey
     bool no_shadows;
     bool hide_makeup;            // the bare face (a before / after comparison)
@@ -167,6 +170,8 @@ typedef struct rouge_face_desc {
     uint32_t undo_levels;        // strokes kept for undo; 0 = 64
     bool manual_navigation;      // pointer gestures only report orbit / pan / zoom, the camera stays
     bool no_float_targets;       // force the RGBA8 fallback (tests; drivers with broken float blending)
+    const char *env_dir;         // where the named environments' .rse files are looked for first; NULL =
+                                 // only assets/env (a source tree) and the installed share/rouge/env
 } rouge_face_desc;
 
 // Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
@@ -174,7 +179,8 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
 // With the creating context current. NULL is fine.
 void rouge_face_destroy(rouge_face *face);
 
-// The view (copied, also the env string). ROUGE_ERR_ARG for an unknown mode, pipeline or environment;
+// The view (copied, also the env string). ROUGE_ERR_ARG for an unknown mode, pipeline or environment,
+// ROUGE_ERR_IO / ROUGE_ERR_FORMAT for an environment file that is missing or corrupt;
 // the previous view stays then.
 rouge_result rouge_face_set_view(rouge_face *face, const rouge_view *view, rouge_error *err);
 // The view as set, with the camera as navigation left it.

@@ -2,12 +2,11 @@
 // attribute.frag.glsl — stage 3: the ray-disk hit's Gaussian weight w, and w-weighted attributes added
 // (GL_ONE, GL_ONE) into three targets; the composite divides by the summed weight. Depth-tested (LEQUAL,
 // no writes) against the visibility pass, so only the front surface layer accumulates.
-//   RT0 = (albedo, 1) w      RT1 = (normal * 0.5 + 0.5, m) w      RT2 = (rho_s, debug colour) w
+//   RT0 = (albedo, 1) w      RT1 = (normal * 0.5 + 0.5, m) w
+//   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w, or (rho_s, debug colour) w in the debug views
 // Normals are stored offset to 0..1 so the RGBA8 fallback needs no signed format; u_weight_scale keeps the
 // fallback's sums below 1 (it cancels in the division) and u_weight_floor keeps a disk's rim from
 // rounding to nothing where it alone covers a pixel (next to occluding edges).
-// RS_ATTR_LEAN (the mobile pipeline's lit modes, float targets): two targets, 16 instead of 24 bytes
-// blended per fragment: RT0 as above, RT1 = (normal.xy, m, rho_s) w.
 precision highp float;
 precision highp int;
 #include "splat_ray.glsl"
@@ -24,12 +23,12 @@ flat in float v_r;
 flat in vec3 v_albedo;
 flat in vec2 v_spec;
 flat in vec3 v_debug;
+flat in vec3 v_layers;
+uniform int u_debug;
 
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;
-#ifndef RS_ATTR_LEAN
 layout(location = 2) out vec4 o_extra;
-#endif
 
 void main()
 {
@@ -40,11 +39,6 @@ void main()
     gl_FragDepth = rs_depth_of(q);
     float w = max(exp(-l * l * u_inv_two_sigma2), u_weight_floor) * u_weight_scale;
     o_albedo = vec4(v_albedo, 1.0) * w;
-#ifdef RS_ATTR_LEAN
-    // Two targets (float only): RT1 = (normal.xy, m, rho_s) w; the composite rebuilds normal.z >= 0.
-    o_normal = vec4(v_n.xy, v_spec) * w;
-#else
     o_normal = vec4(v_n * 0.5 + 0.5, v_spec.x) * w;
-    o_extra = vec4(v_spec.y, v_debug) * w;
-#endif
+    o_extra = vec4(v_spec.y, u_debug != 0 ? v_debug : v_layers) * w;
 }

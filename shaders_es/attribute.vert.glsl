@@ -1,7 +1,8 @@
 #version 300 es
 // attribute.vert.glsl — stage 3, attribute splatting: per splat, what the fragment shader blends: linear
 // albedo (with the makeup layer composed over it), view-space normal, the specular parameters m and rho_s
-// from the region table (and makeup), and a debug colour (region or LOD level).
+// from the region table (and makeup), the finish layers (clear coat, flakes) and the splat's ambient
+// occlusion, and a debug colour (region or LOD level).
 precision highp float;
 precision highp int;
 #include "splat_decode.glsl"
@@ -10,7 +11,7 @@ precision highp int;
 #include "makeup.glsl"
 
 layout(location = 0) in uvec4 a_splat;
-layout(location = 1) in uvec2 a_makeup;   // rs_makeup_gpu, 8 bytes per splat; all zero = no makeup
+layout(location = 1) in uvec3 a_makeup;   // rs_makeup_gpu, 12 bytes per splat; all zero = no makeup
 uniform mat4 u_view;
 uniform float u_radius_scale;
 uniform float u_cull_cos;
@@ -28,6 +29,7 @@ flat out vec3 v_n;
 flat out float v_r;
 flat out vec3 v_albedo;
 flat out vec2 v_spec;    // m, rho_s
+flat out vec3 v_layers;  // ambient occlusion, clear-coat weight, flake weight
 flat out vec3 v_debug;
 
 // The coarsest LOD level whose prefix holds splat i (the table descends: lods[0] = all splats).
@@ -52,12 +54,14 @@ void main()
     vec3 albedo = s.albedo;
     float m = u_region_m[region];
     float rho_s = u_region_rho[region];
-    if (u_makeup_on > 0.5) rs_makeup_apply(a_makeup, albedo, m, rho_s);
+    float coat = 0.0, shimmer = 0.0;
+    if (u_makeup_on > 0.5) rs_makeup_apply(a_makeup, albedo, m, rho_s, coat, shimmer);
     v_c = c;
     v_n = n;
     v_r = s.radius * u_radius_scale;
     v_albedo = albedo;
     v_spec = vec2(m, rho_s);
+    v_layers = vec3(s.ao, coat, shimmer);
     v_debug = u_debug == 1 ? u_debug_color[region]
             : u_debug == 2 ? u_debug_color[lod_level(rs_splat_index())] : vec3(0.0);
     rs_sprite(c, v_r * u_coverage);

@@ -1,14 +1,17 @@
 #version 300 es
-// composite.frag.glsl — stage 5: normalises the accumulated attributes (albedo A, normal N, m, rho_s),
-// evaluates the specular S per pixel (Kelemen/Szirmay-Kalos, shadowed key light + unshadowed fill), reads
-// the diffuse D of stage 4, and composes F = A (D + S) (paper eq. 1) or F = A D + S; then exposure and the
-// sRGB encoding. Also the debug views (render.h rs_render_mode).
+// composite.frag.glsl — stage 5: normalises the accumulated attributes (albedo A, normal N, m, rho_s,
+// ambient occlusion, clear coat, flakes), evaluates the specular S per pixel (Kelemen/Szirmay-Kalos: the
+// shadowed key light, the unshadowed fill, the environment's prefiltered radiance), reads the diffuse D
+// of stage 4, and composes F = A (D + S) (paper eq. 1) or F = A D + S, then adds the makeup's untinted
+// clear coat and its flakes; then exposure, the filmic curve (or a clamp) and the sRGB encoding. Also the
+// debug views (render.h rs_render_mode).
 precision highp float;
 precision highp int;
 #define RS_NEEDS_VISIBLE_POINT 1
 #include "splat_ray.glsl"
 #include "shadow_lookup.glsl"
 #include "skin_brdf.glsl"
+#include "env_light.glsl"
 
 // Same numbering as rs_render_mode in render.h.
 #define MODE_FULL 0
@@ -39,9 +42,45 @@ uniform vec3 u_fill_dir;
 uniform vec3 u_fill_color;
 uniform vec3 u_ambient;
 uniform float u_min_weight;     // accumulated weights below this are unreliable (RGBA8 fallback): a hole
-uniform int u_lean;             // 1: two attribute targets, RT1 = (normal.xy, m, rho_s) w (no RT2)
+uniform float u_key_widen;      // the key light's angular radius / 2: added in quadrature to m (area light)
+uniform int u_tonemap;          // 0: filmic, 1: clamp (the paper's figures)
+uniform mat4 u_inv_view;        // view -> model (flakes are fixed on the surface)
+uniform float u_flake_size;     // model units
 
 out vec4 o_color;
+
+// ACES filmic fit (Narkowicz 2015): a toe, a soft shoulder that keeps highlights from clipping flat.
+vec3 filmic(vec3 x)
+{
+    return clamp(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0, 1.0);
+}
+
+// Integer hash (a PCG step) of a flake cell: three uniform numbers in 0..1 and one for presence.
+vec4 flake_hash(ivec3 c)
+{
+    uvec3 v = uvec3(c) * uvec3(1664525u, 1013904223u, 2654435761u);
+    v.x += v.y * v.z; v.y += v.z * v.x; v.z += v.x * v.y;
+    v ^= v >> 16u;
+    v.x += v.y * v.z; v.y += v.z * v.x; v.z += v.x * v.y;
+    uint w = v.x ^ v.y ^ v.z;
+    return vec4(v, w * 747796405u) / 4294967295.0;
+}
+
+// The flakes of a shimmer finish: tiny mirrors in cells of u_flake_size on the surface, each tilted at
+// random by up to ~25 degrees from the surface normal; about a third of the cells hold one. A flake
+// lights up when its own mirror direction meets a bright part of the light: sparkle that moves with the
+// light and the face.
+vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao)
+{
+    vec3 pm = (u_inv_view * vec4(p, 1.0)).xyz;
+    vec4 h = flake_hash(ivec3(floor(pm / u_flake_size)));
+    if (h.w > 0.35) return vec3(0.0);
+    vec3 Nf = normalize(N + (h.xyz * 2.0 - 1.0) * 0.45);
+    const float mf = 0.08;
+    vec3 s = u_key_color * (rs_ksk_lobe(Nf, u_key_dir, V, sqrt(mf * mf + u_key_widen * u_key_widen), 0.5) * shadow);
+    if (u_env_on > 0.5) s += rs_env_specular(Nf, V, mf, 0.5) * ao;
+    return s * tint;
+}
 
 vec3 linear_to_srgb(vec3 c)
 {
@@ -101,20 +140,11 @@ void main()
     float inv = 1.0 / t0.a;
     vec3 A = t0.rgb * inv;
     vec3 N, debug = vec3(0.0);
-    float m, rho_s;
-    if (u_lean == 1) {
-        // The visible side faces the camera: z >= 0 (silhouette splats tilted a little away excepted).
-        vec2 nxy = t1.xy * inv;
-        N = vec3(nxy, sqrt(max(1.0 - dot(nxy, nxy), 0.0)));
-        N = normalize(N);
-        m = t1.z * inv;
-        rho_s = t1.w * inv * u_rho_s_scale;
-    } else {
-        N = normalize(t1.xyz * inv * 2.0 - 1.0);
-        m = t1.a * inv;
-        rho_s = t2.r * inv * u_rho_s_scale;
-        debug = t2.gba * inv;
-    }
+    N = normalize(t1.xyz * inv * 2.0 - 1.0);
+    float m = t1.a * inv;
+    float rho_s = t2.r * inv * u_rho_s_scale;
+    debug = t2.gba * inv;       // the debug views' colour, else (ambient occlusion, coat, flakes)
+    float ao = debug.x, coat = debug.y, shimmer = debug.z;
     vec3 V = normalize(-p);
 
     if (u_mode == MODE_NORMALS) { o_color = vec4(N * 0.5 + 0.5, 1.0); return; }
@@ -126,16 +156,35 @@ void main()
     if (u_mode == MODE_ALBEDO) {
         c = A;
     } else {
-        vec3 S = u_key_color * (rs_ksk_specular(N, u_key_dir, V, m, rho_s) * shadow)
+        // The key light is an area light when it stands for an environment's brightest region: its
+        // angular size widens the lobe (roughness added in quadrature), keeping the lobe's energy.
+        float mk = sqrt(m * m + u_key_widen * u_key_widen);
+        vec3 S = u_key_color * (rs_ksk_specular(N, u_key_dir, V, mk, rho_s) * shadow)
                + u_fill_color * rs_ksk_specular(N, u_fill_dir, V, m, rho_s);
         vec3 E = u_key_color * max(dot(N, u_key_dir), 0.0) * shadow + u_fill_color * max(dot(N, u_fill_dir), 0.0)
                + u_ambient;
+        // The makeup's clear coat: the same lobe family, smooth (m 0.1), F0 0.04, untinted, on top.
+        const float mc = 0.1;
+        vec3 C = vec3(0.0);
+        if (coat > 0.0)
+            C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
+                               * shadow);
+        if (u_env_on > 0.5) {
+            // Sky occlusion stands in for the specular's visibility too (eye sockets, nostrils).
+            E += rs_env_irradiance(N) * ao;
+            S += rs_env_specular(N, V, m, RS_F0_SKIN) * (rho_s * ao);
+            if (coat > 0.0) C += rs_env_specular(N, V, mc, RS_F0_COAT) * ao;
+        }
+        C *= coat;
+        // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).
+        if (shimmer > 0.0) C += flakes(p, N, V, A / max(max(A.r, max(A.g, A.b)), 0.05), shadow, ao) * shimmer;
         D = D * u_diffuse_scale + u_delta_weight * E;
         if (u_mode == MODE_DIFFUSE) c = A * D;
-        else if (u_mode == MODE_SPECULAR) c = S;
+        else if (u_mode == MODE_SPECULAR) c = S + C;
         else if (u_mode == MODE_IRRADIANCE) c = E;
-        else c = u_physical == 1 ? A * D + S : A * (D + S);
+        else c = (u_physical == 1 ? A * D + S : A * (D + S)) + C;
         c *= u_exposure;
+        if (u_tonemap == 0 && u_linear_output < 0.5) c = filmic(c);
     }
     o_color = vec4(u_linear_output > 0.5 ? clamp(c, 0.0, 1.0) : linear_to_srgb(c), 1.0);
 }

@@ -1,6 +1,9 @@
 // skin_brdf.glsl — the Kelemen/Szirmay-Kalos specular BRDF as GPU Gems 3 ch. 14 uses it (METHOD.md):
 // Beckmann P_H without the 1/pi (so Weyrich et al.'s rho_s keep their meaning), Schlick Fresnel with
 // F0 = 0.028 (skin, n = 1.4), S = (N.L) rho_s max(P_H F / dot(h, h), 0) with h = L + V unnormalised.
+// The same lobe with rho_s 1 and F0 0.04 is the clear coat of a gloss (docs/makeup.md).
+#define RS_F0_SKIN 0.028
+#define RS_F0_COAT 0.04
 
 float rs_beckmann(float ndoth, float m)
 {
@@ -9,13 +12,13 @@ float rs_beckmann(float ndoth, float m)
     return exp((c2 - 1.0) / (c2 * m2)) / (m2 * c2 * c2);  // exp(-tan^2(a)/m^2) / (m^2 cos^4(a))
 }
 
-float rs_schlick(float vdoth)
+float rs_schlick(float vdoth, float f0)
 {
     float e = pow(1.0 - vdoth, 5.0);
-    return e + 0.028 * (1.0 - e);
+    return e + f0 * (1.0 - e);
 }
 
-float rs_ksk_specular(vec3 N, vec3 L, vec3 V, float m, float rho_s)
+float rs_ksk_lobe(vec3 N, vec3 L, vec3 V, float m, float f0)
 {
     float ndotl = dot(N, L);
     vec3 h = L + V;
@@ -25,6 +28,11 @@ float rs_ksk_specular(vec3 N, vec3 L, vec3 V, float m, float rho_s)
     float ndoth = dot(N, H);
     if (ndoth <= 0.0) return 0.0;
     float ph = rs_beckmann(ndoth, max(m, 0.02));
-    float f = rs_schlick(clamp(dot(V, H), 0.0, 1.0));
-    return ndotl * rho_s * max(ph * f / hh, 0.0);
+    float f = rs_schlick(clamp(dot(V, H), 0.0, 1.0), f0);
+    return ndotl * max(ph * f / hh, 0.0);
+}
+
+float rs_ksk_specular(vec3 N, vec3 L, vec3 V, float m, float rho_s)
+{
+    return rho_s * rs_ksk_lobe(N, L, V, m, RS_F0_SKIN);
 }

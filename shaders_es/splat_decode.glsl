@@ -3,6 +3,7 @@
 uniform vec3 u_bbox_min;      // quantization frame, model units
 uniform vec3 u_bbox_step;     // (bbox_max - bbox_min) / 65535
 uniform vec2 u_radius_log;    // radius = u_radius_log.x * exp(u_radius_log.y * q), q = 0..255
+uniform float u_has_ao;       // 1: byte 15 of the record is the splat's ambient occlusion (RS_SPLAT_FLAG_AO)
 
 struct rs_splat {
     vec3 pos;       // model units
@@ -10,6 +11,7 @@ struct rs_splat {
     float radius;   // model units (before the LOD scale)
     vec3 albedo;    // linear RGB
     uint region;
+    float ao;       // ambient occlusion, 1 = open sky (1 when the file has none)
 };
 
 float rs_snorm16(uint bits)
@@ -41,6 +43,7 @@ rs_splat rs_decode_splat(uvec4 w)
     s.pos = u_bbox_min + vec3(float(w.x & 0xffffu), float(w.x >> 16), float(w.y & 0xffffu)) * u_bbox_step;
     s.radius = u_radius_log.x * exp(u_radius_log.y * float((w.y >> 16) & 0xffu));
     s.region = w.y >> 24;
+    s.ao = u_has_ao > 0.5 ? float(w.w >> 24) / 255.0 : 1.0;
     s.normal = rs_decode_normal(w.z);
     s.albedo = rs_srgb_to_linear(vec3(float(w.w & 0xffu), float((w.w >> 8) & 0xffu),
                                       float((w.w >> 16) & 0xffu)) / 255.0);

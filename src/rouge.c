@@ -5,6 +5,7 @@
 
 #include "core/core.h"
 #include "core/image.h"
+#include "formats/env_lookup.h"
 #include "formats/look.h"
 #include "formats/strokes.h"
 #include "gl/gl.h"
@@ -23,6 +24,7 @@
 _Static_assert((int)ROUGE_ERR_ARG == (int)RS_ERR_ARG && (int)ROUGE_ERR_GL == (int)RS_ERR_GL, "rouge_result");
 _Static_assert((int)ROUGE_MODE_COUNT == (int)RS_MODE_COUNT, "rouge_mode");
 _Static_assert(ROUGE_MAX_LODS == RS_SPLAT_MAX_LODS, "ROUGE_MAX_LODS");
+_Static_assert((int)ROUGE_COMPOSITE_PHYSICAL == (int)RS_COMPOSITE_PHYSICAL, "rouge_composite");
 _Static_assert(sizeof(((rouge_error *)0)->msg) == sizeof(((rs_error *)0)->msg), "rouge_error");
 
 #define ROUGE_ENV_MAX 64
@@ -39,7 +41,9 @@ struct rouge_face {
     rs_makeup *mk;
     rs_paint *paint;
     rouge_view view;              // as set (env points at env_name)
-    char env_name[ROUGE_ENV_MAX];
+    char env_name[ROUGE_ENV_MAX]; // the environment uploaded to the renderer ("" = none yet)
+    char view_env[ROUGE_ENV_MAX]; // view.env points here
+    char *env_dir;                // rouge_face_desc.env_dir
     rs_view frame_view;           // the view of the last frame: pointer coordinates and picks refer to it
     bool have_frame;
     bool changed;                 // view or makeup changed since the last frame
@@ -226,9 +230,12 @@ static rs_view to_rs_view(const rouge_view *p, int w, int h)
         for (int c = 0; c < 3; c++) out[i]->color[c] = black ? 1.0f : in[i]->color[c];
     }
     if (p->ambient != 0) v.ambient = p->ambient > 0 ? p->ambient : 0.0f;
+    // "paper": the paper's lamp (and, by the renderer's defaults, its composite and no tone curve).
+    v.lighting = rs_env_is_paper(p->env) ? RS_LIGHTING_LIGHTS : RS_LIGHTING_ENV;
+    v.env_rotate_deg = p->env_rotation_deg;
     v.mode = (rs_render_mode)p->mode;
     v.pipeline = p->pipeline == ROUGE_PIPELINE_REFERENCE ? RS_PIPELINE_REFERENCE : RS_PIPELINE_MOBILE;
-    v.composite = p->composite == ROUGE_COMPOSITE_PHYSICAL ? RS_COMPOSITE_PHYSICAL : RS_COMPOSITE_PAPER;
+    v.composite = (rs_composite)p->composite;
     if (p->exposure > 0) v.exposure = p->exposure;
     if (p->background[3] > 0)
         for (int c = 0; c < 3; c++) v.background[c] = p->background[c];
@@ -271,13 +278,33 @@ rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_er
     if ((unsigned)v.composite > ROUGE_COMPOSITE_PHYSICAL) return fail_arg(err, "view: unknown composite");
     if ((unsigned)v.primitive > ROUGE_PRIMITIVE_QUADS) return fail_arg(err, "view: unknown primitive");
     if (v.width < 0 || v.height < 0) return fail_arg(err, "view: negative size");
-    if (v.env && v.env[0]) {
+    if (!isfinite(v.env_rotation_deg) || fabsf(v.env_rotation_deg) > 1e6f)
+        return fail_arg(err, "view: environment rotation not a finite, sane number");
+    const char *env = v.env && v.env[0] ? v.env : RS_ENV_DEFAULT;
+    if (strlen(env) >= ROUGE_ENV_MAX) return fail_arg(err, "view: environment name or path too long");
+    if (!rs_env_is_paper(env) && strcmp(env, f->env_name) != 0) {
+        // A new environment: load and upload it now, so a bad name or file fails here and the old
+        // view stays.
+        rs_env *e_cpu = NULL;
         rs_error e = {0};
-        rs_fail(&e, RS_ERR_ARG, "view: unknown environment '%.64s' (this build has none)", v.env);
-        return fail_out(err, &e);
+        rs_result r = rs_env_open(env, f->env_dir, &e_cpu, &e);
+        if (r == RS_OK) {
+            gl_saved s;
+            gl_save(&s);
+            r = rs_render_set_env(f->ren, e_cpu, &e);
+            gl_restore(&s);
+        }
+        rs_env_destroy(e_cpu);
+        if (r != RS_OK) {
+            // The renderer's environment is gone when the upload failed half-way: say so next time.
+            if (!rs_render_has_env(f->ren)) f->env_name[0] = 0;
+            return fail_out(err, &e);
+        }
+        snprintf(f->env_name, sizeof f->env_name, "%s", env);
     }
-    f->env_name[0] = 0;
-    v.env = f->env_name;
+    // The view keeps its own copy of the name (the caller's string need not outlive the call).
+    snprintf(f->view_env, sizeof f->view_env, "%s", env);
+    v.env = f->view_env;
     f->view = v;
     if (f->have_frame) {
         // Keep the last frame's size for pointer coordinates until the next frame.
@@ -441,6 +468,14 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
     if (!f) return rs_fail(&e, RS_ERR_NOMEM, "out of memory"), fail_out(err, &e);
     f->manual_navigation = desc->manual_navigation;
     f->painting = true;
+    if (desc->env_dir) {
+        size_t n = strlen(desc->env_dir) + 1;
+        if (!(f->env_dir = malloc(n))) {
+            free(f);
+            return rs_fail(&e, RS_ERR_NOMEM, "out of memory"), fail_out(err, &e);
+        }
+        memcpy(f->env_dir, desc->env_dir, n);
+    }
     rs_result r = desc->path ? rs_splat_load(desc->path, &f->cloud, &e)
                              : rs_splat_load_memory(desc->data, desc->size, &f->cloud, &e);
     gl_saved s;
@@ -474,6 +509,7 @@ void rouge_face_destroy(rouge_face *f)
     if (!f) return;
     rs_strokes_destroy(f->rec);
     free(f->rec_path);
+    free(f->env_dir);
     rs_paint_destroy(f->paint);
     rs_makeup_destroy(f->mk);
     if (f->ren) {
@@ -746,6 +782,7 @@ rouge_result rouge_face_record_strokes(rouge_face *f, const char *path, rouge_er
     rs_paint_set_recorder(f->paint, NULL, NULL);
     rs_strokes_destroy(f->rec);
     free(f->rec_path);
+    free(f->env_dir);
     f->rec = NULL, f->rec_path = NULL;
     if (!path) return ROUGE_OK;
     f->rec_path = malloc(strlen(path) + 1);

@@ -6,6 +6,7 @@
 // The bundled face from a 30k-splat LOD prefix at 96x96 (a few seconds on llvmpipe).
 #include "support/harness.h"
 #include "gl/gl.h"
+#include "formats/env_lookup.h"
 #include "render/render.h"
 #include "rouge.h"
 
@@ -67,9 +68,14 @@ static void test_zero_view_is_the_default_view(void)
     RS_REQUIRE(rs_splat_load(FACE, &c, &re) == RS_OK, "%s", re.msg);
     rs_view d = rs_view_defaults();
     d.width = d.height = SIZE, d.max_splats = MAX_SPLATS, d.pipeline = RS_PIPELINE_MOBILE;
+    // ... lit by the default environment, as rouge.h's NULL env.
+    rs_env *env = NULL;
     if (RS_CHECK(rs_render_create(&(rs_render_desc){.cloud = c, .caps = rs_gl_get_caps(gl)}, &r, &re) == RS_OK, "%s", re.msg) &&
+        RS_CHECK(rs_env_open(RS_ENV_DEFAULT, NULL, &env, &re) == RS_OK, "%s", re.msg) &&
+        RS_CHECK(rs_render_set_env(r, env, &re) == RS_OK, "%s", re.msg) &&
         RS_CHECK(rs_render_image(r, &d, &b, &re) == RS_OK, "%s", re.msg))
         RS_CHECK(same(&a, &b), "zero rouge_view differs from rs_view_defaults() (%d pixels)", changed_pixels(&a, &b));
+    rs_env_destroy(env);
     rs_render_destroy(r);
     rs_splat_destroy(c);
     rs_image_free(&a);

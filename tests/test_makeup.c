@@ -163,13 +163,13 @@ static void test_eq2_blend_is_linear_and_zero_record_is_base(void)
     rs_makeup_uniforms u = {{0, 0, 0}, {1, 1, 1}};
     float base[3] = {0.5f, 0.3f, 0.2f}, c[3];
     float m = 0.27f, rho = 0.23f;
-    rs_makeup_gpu zero = {{0}, 0, 0, 0, 0, 0};
+    rs_makeup_gpu zero = {0};
     memcpy(c, base, sizeof c);
     rs_makeup_apply_cpu(&zero, &u, c, &m, &rho);
     RS_CHECK(memcmp(c, base, sizeof c) == 0 && m == 0.27f && rho == 0.23f, "zero record must leave the base exactly");
 
     // Full intensity, detail ratio 1 (flags 128): the pigment's linear colour.
-    rs_makeup_gpu full = {{255, 0, 128}, 255, 0, 0, 0, 128};
+    rs_makeup_gpu full = {.rgb = {255, 0, 128}, .colour_i = 255, .flags = 128};
     memcpy(c, base, sizeof c);
     rs_makeup_apply_cpu(&full, &u, c, &m, &rho);
     RS_CHECK(fabsf(c[0] - 1.0f) < 1e-6f && c[1] == 0.0f && fabsf(c[2] - rs_srgb_to_linear(128 / 255.0f)) < 1e-6f,
@@ -202,7 +202,7 @@ static void test_composition_of_two_products_equals_sequential_blends(void)
     const rs_cosmetic *a = rs_cosmetic_find("blush"), *b = rs_cosmetic_find("foundation_2");
     float amounts[][2] = {{0.3f, 0.5f}, {0.9f, 0.1f}, {0.05f, 0.7f}, {0.6f, 0.6f}};
     for (size_t t = 0; t < RS_COUNT_OF(amounts); t++) {
-        rs_makeup_gpu ra = {{0}, 0, 0, 0, 0, 0}, rb = ra, rab = ra;
+        rs_makeup_gpu ra = {0}, rb = ra, rab = ra;
         rs_makeup_compose(&ra, a, amounts[t][0], 128);
         rs_makeup_compose(&rb, b, amounts[t][1], 128);
         rs_makeup_compose(&rab, a, amounts[t][0], 128);
@@ -230,7 +230,7 @@ static void test_foundation_shades_darken_in_order(void)
     for (int s = 1; s <= 3; s++) {
         char name[32];
         snprintf(name, sizeof name, "foundation_%d", s);
-        rs_makeup_gpu r = {{0}, 0, 0, 0, 0, 0};
+        rs_makeup_gpu r = {0};
         rs_makeup_compose(&r, rs_cosmetic_find(name), 0.8f, 128);
         float c[3] = {0.45f, 0.3f, 0.25f}, m = 0.27f, rho = 0.23f;
         rs_makeup_apply_cpu(&r, &u, c, &m, &rho);
@@ -242,7 +242,7 @@ static void test_foundation_shades_darken_in_order(void)
 static void test_lip_gloss_raises_rho_s_lowers_m_and_keeps_colour(void)
 {
     rs_makeup_uniforms u = {{0, 0, 0}, {1, 1, 1}};
-    rs_makeup_gpu r = {{0}, 0, 0, 0, 0, 0};
+    rs_makeup_gpu r = {0};
     rs_makeup_compose(&r, rs_cosmetic_find("lip_gloss"), 0.8f, 128);
     RS_CHECK(r.colour_i == 0, "lip gloss is colourless: colour_i %d", r.colour_i);
     float c[3] = {0.4f, 0.12f, 0.12f}, m = 0.28f, rho = 0.28f;
@@ -254,13 +254,13 @@ static void test_lip_gloss_raises_rho_s_lowers_m_and_keeps_colour(void)
 static void test_powder_lowers_rho_s_raises_m(void)
 {
     rs_makeup_uniforms u = {{0, 0, 0}, {1, 1, 1}};
-    rs_makeup_gpu r = {{0}, 0, 0, 0, 0, 0};
+    rs_makeup_gpu r = {0};
     rs_makeup_compose(&r, rs_cosmetic_find("powder"), 0.8f, 128);
     float c[3] = {0.4f, 0.3f, 0.25f}, m = 0.265f, rho = 0.265f;  // forehead, paper Table 1
     rs_makeup_apply_cpu(&r, &u, c, &m, &rho);
     RS_CHECK(rho < 0.265f - 0.1f && m > 0.265f + 0.05f, "powder: rho_s %g (want down), m %g (want up)", rho, m);
     // Highlighter does the opposite to rho_s.
-    rs_makeup_gpu h = {{0}, 0, 0, 0, 0, 0};
+    rs_makeup_gpu h = {0};
     rs_makeup_compose(&h, rs_cosmetic_find("highlighter"), 0.8f, 128);
     float m2 = 0.265f, rho2 = 0.265f;
     rs_makeup_apply_cpu(&h, &u, c, &m2, &rho2);

@@ -856,22 +856,22 @@ static void test_mirror_painting_is_symmetric_about_the_mid_plane(void)
 // ---- GLSL makeup compose == CPU mirror -----------------------------------------------------------------
 
 // Runs rs_makeup_apply (shaders_es/makeup.glsl, the embedded text the renderer compiles) over n records
-// with transform feedback; out gets albedo rgb, m, rho_s per record.
+// with transform feedback; out gets albedo rgb, m, rho_s, coat, shimmer per record.
 static bool gpu_apply(const rs_makeup_gpu *rec, const float (*alb)[3], const float (*mr)[2], uint32_t n,
-                      const rs_makeup_uniforms *u, float (*out)[5])
+                      const rs_makeup_uniforms *u, float (*out)[7])
 {
     const char *mk_src = rs_shader_find("makeup.glsl");
     if (!RS_CHECK(mk_src != NULL, "makeup.glsl not embedded")) return false;
     static const char *vs_tail =
-        "layout(location = 0) in uvec2 a_rec;\n"
+        "layout(location = 0) in uvec3 a_rec;\n"
         "layout(location = 1) in vec3 a_alb;\n"
         "layout(location = 2) in vec2 a_mr;\n"
         "out vec3 o_alb;\n"
-        "out vec2 o_mr;\n"
+        "out vec4 o_mr;\n"
         "void main() {\n"
-        "    vec3 a = a_alb; float m = a_mr.x, r = a_mr.y;\n"
-        "    rs_makeup_apply(a_rec, a, m, r);\n"
-        "    o_alb = a; o_mr = vec2(m, r);\n"
+        "    vec3 a = a_alb; float m = a_mr.x, r = a_mr.y, coat, shimmer;\n"
+        "    rs_makeup_apply(a_rec, a, m, r, coat, shimmer);\n"
+        "    o_alb = a; o_mr = vec4(m, r, coat, shimmer);\n"
         "    gl_Position = vec4(0.0, 0.0, 0.0, 1.0);\n"
         "}\n";
     static const char *fs = "#version 300 es\nprecision mediump float;\nout vec4 c;\nvoid main() { c = vec4(0.0); }\n";
@@ -906,7 +906,7 @@ static bool gpu_apply(const rs_makeup_gpu *rec, const float (*alb)[3], const flo
     glBindBuffer(GL_ARRAY_BUFFER, buf[0]);
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(n * sizeof *rec), rec, GL_STATIC_DRAW);
     glEnableVertexAttribArray(0);
-    glVertexAttribIPointer(0, 2, GL_UNSIGNED_INT, sizeof *rec, NULL);
+    glVertexAttribIPointer(0, 3, GL_UNSIGNED_INT, sizeof *rec, NULL);
     glBindBuffer(GL_ARRAY_BUFFER, buf[1]);
     glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(n * sizeof *alb), alb, GL_STATIC_DRAW);
     glEnableVertexAttribArray(1);
@@ -974,12 +974,12 @@ static void test_glsl_makeup_compose_matches_cpu_mirror(void)
     rs_makeup_gpu *rec = calloc(GPU_N, sizeof *rec);
     float(*alb)[3] = calloc(GPU_N, sizeof *alb);
     float(*mr)[2] = calloc(GPU_N, sizeof *mr);
-    float(*out)[5] = calloc(GPU_N, sizeof *out);
+    float(*out)[7] = calloc(GPU_N, sizeof *out);
     RS_REQUIRE(rec && alb && mr && out, "out of memory");
     uint32_t seed = 0x9e3779b9u;
     for (uint32_t i = 0; i < GPU_N; i++) {
         uint8_t *b = (uint8_t *)&rec[i];
-        for (int k = 0; k < 8; k++) b[k] = (uint8_t)rng_next(&seed);
+        for (int k = 0; k < 11; k++) b[k] = (uint8_t)rng_next(&seed);
         if (i % 7 == 0) rec[i].colour_i = 0;
         if (i % 5 == 0) rec[i].spec_i = 0;
         if (i % 101 == 0) memset(&rec[i], 0, sizeof rec[i]);
@@ -1004,8 +1004,9 @@ static void test_glsl_makeup_compose_matches_cpu_mirror(void)
         for (uint32_t i = 0; i < GPU_N; i++) {
             float a[3] = {alb[i][0], alb[i][1], alb[i][2]}, m = mr[i][0], r = mr[i][1];
             rs_makeup_apply_cpu(&rec[i], &u[k], a, &m, &r);
-            float cpu[5] = {a[0], a[1], a[2], m, r};
-            for (int c = 0; c < 5; c++) {
+            float cpu[7] = {a[0], a[1], a[2], m, r, 0, 0};
+            rs_makeup_layers_cpu(&rec[i], &cpu[5], &cpu[6]);
+            for (int c = 0; c < 7; c++) {
                 double d = fabs((double)cpu[c] - out[i][c]);
                 if (d > worst) worst = d, wi = i;
             }

@@ -286,3 +286,18 @@ double rs_time_now(void)
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
 }
+
+float rs_lef32_get(const uint8_t *p)
+{
+    uint32_t u = rs_le32_get(p);
+    float f;
+    memcpy(&f, &u, sizeof f);
+    return f;
+}
+
+void rs_lef32_put(uint8_t *p, float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    rs_le32_put(p, u);
+}

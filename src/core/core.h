@@ -61,6 +61,18 @@ rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, 
 // Writes via "<path>.tmp.<pid>" then fsync + rename: readers see the old or the new file, never a mix.
 rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err);
 
+// Little-endian fields of binary files (every rouge format is little-endian, whatever the host).
+static inline uint32_t rs_le32_get(const uint8_t *p)
+{
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+static inline void rs_le32_put(uint8_t *p, uint32_t v)
+{
+    p[0] = (uint8_t)v, p[1] = (uint8_t)(v >> 8), p[2] = (uint8_t)(v >> 16), p[3] = (uint8_t)(v >> 24);
+}
+float rs_lef32_get(const uint8_t *p);
+void rs_lef32_put(uint8_t *p, float f);
+
 // Monotonic clock in seconds, for benches and adaptive LOD (never for test assertions).
 double rs_time_now(void);
 

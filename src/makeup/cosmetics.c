@@ -18,41 +18,58 @@
 #include <stdio.h>
 #include <string.h>
 
-//  name, kind, sRGB, I_M, colour w, finish w, m, rho_s, size (diameter / face height), opacity
+//  name, kind, sRGB, I_M, colour w, finish w, m, rho_s, size (diameter / face height), opacity, coat, shimmer,
+//  coverage
 static const rs_cosmetic presets[] = {
     // Foundation shades 1 (light) to 3 (deep), a warm-neutral undertone like most skin. Satin-matte:
     // a little rougher and less specular than skin (the paper: base makeup reduces oily shine).
     // Large blending brush (0.3 = the paper's largest tool), medium coverage.
-    {"foundation_1", RS_COSMETIC_FOUNDATION, {236, 203, 178}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f},
-    {"foundation_2", RS_COSMETIC_FOUNDATION, {208, 164, 132}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f},
-    {"foundation_3", RS_COSMETIC_FOUNDATION, {168, 122, 92}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f},
+    {"foundation_1", RS_COSMETIC_FOUNDATION, {236, 203, 178}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f,
+     0.0f, 0.0f, 0.0f},
+    {"foundation_2", RS_COSMETIC_FOUNDATION, {208, 164, 132}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f,
+     0.0f, 0.0f, 0.0f},
+    {"foundation_3", RS_COSMETIC_FOUNDATION, {168, 122, 92}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f,
+     0.0f, 0.0f, 0.0f},
     // Translucent setting powder: barely tints (colour weight 0.15, a slight brightening), fully matte:
     // roughness up, rho_s to about a third of skin. This is the "reduced shine" of the paper's Fig. 12.
-    {"powder", RS_COSMETIC_POWDER, {236, 218, 204}, 0.50f, 0.15f, 1.00f, 0.45f, 0.07f, 0.30f, 0.60f},
+    {"powder", RS_COSMETIC_POWDER, {236, 218, 204}, 0.50f, 0.15f, 1.00f, 0.45f, 0.07f, 0.30f, 0.60f,
+     0.0f, 0.0f, 0.0f},
     // Powder blush, rose: sheer (low I_M, opacity 0.35) so it builds up over strokes; matte-ish finish
     // at half weight (a powder over skin, not a full film).
-    {"blush", RS_COSMETIC_BLUSH, {220, 112, 122}, 0.35f, 1.00f, 0.50f, 0.35f, 0.14f, 0.20f, 0.35f},
+    {"blush", RS_COSMETIC_BLUSH, {220, 112, 122}, 0.35f, 1.00f, 0.50f, 0.35f, 0.14f, 0.20f, 0.35f,
+     0.0f, 0.0f, 0.0f},
     // Bronzer: warm brown, sheer, matte; contour: cooler, greyer brown that reads as shadow.
-    {"bronzer", RS_COSMETIC_BRONZER, {168, 110, 76}, 0.35f, 1.00f, 0.50f, 0.36f, 0.13f, 0.20f, 0.30f},
-    {"contour", RS_COSMETIC_BRONZER, {132, 100, 84}, 0.35f, 1.00f, 0.50f, 0.36f, 0.13f, 0.15f, 0.30f},
+    {"bronzer", RS_COSMETIC_BRONZER, {168, 110, 76}, 0.35f, 1.00f, 0.50f, 0.36f, 0.13f, 0.20f, 0.30f,
+     0.0f, 0.0f, 0.0f},
+    {"contour", RS_COSMETIC_BRONZER, {132, 100, 84}, 0.35f, 1.00f, 0.50f, 0.36f, 0.13f, 0.15f, 0.30f,
+     0.0f, 0.0f, 0.0f},
     // Highlighter, shimmer: pale champagne at half colour weight (a sheen, not white paint); smoother
     // and brighter specular (rho_s 0.45, ~1.5-2x skin) is what makes it catch the light.
-    {"highlighter", RS_COSMETIC_HIGHLIGHTER, {250, 236, 214}, 0.40f, 0.50f, 1.00f, 0.21f, 0.45f, 0.12f, 0.50f},
+    {"highlighter", RS_COSMETIC_HIGHLIGHTER, {250, 236, 214}, 0.40f, 0.50f, 1.00f, 0.21f, 0.45f, 0.12f, 0.50f,
+     0.0f, 0.80f, 0.0f},
     // Lipsticks: opaque, small brush. Matte red: rough, low specular. Satin pink: about the lips' own
     // measured finish (m 0.27-0.30, rho_s 0.26-0.31), so colour changes but the sheen stays.
     // Lipsticks are the most opaque products: full coverage and high pigment load, so two passes cover
     // the lips (I ~ 0.94 at the brush centre) while the lips' texture still shows through.
-    {"lipstick_matte", RS_COSMETIC_LIPSTICK, {168, 36, 54}, 0.95f, 1.00f, 1.00f, 0.42f, 0.09f, 0.08f, 1.00f},
-    {"lipstick_satin", RS_COSMETIC_LIPSTICK, {204, 78, 118}, 0.90f, 1.00f, 1.00f, 0.27f, 0.28f, 0.08f, 1.00f},
+    {"lipstick_matte", RS_COSMETIC_LIPSTICK, {168, 36, 54}, 0.95f, 1.00f, 1.00f, 0.42f, 0.09f, 0.08f, 1.00f,
+     0.0f, 0.0f, 0.60f},
+    {"lipstick_satin", RS_COSMETIC_LIPSTICK, {204, 78, 118}, 0.90f, 1.00f, 1.00f, 0.27f, 0.28f, 0.08f, 1.00f,
+     0.25f, 0.0f, 0.40f},
     // Lip gloss: colourless (colour weight 0: the record's colour intensity stays 0), a clear wet coat:
-    // smooth (m 0.14) and about twice the lips' specular (rho_s 0.55).
-    {"lip_gloss", RS_COSMETIC_LIP_GLOSS, {255, 255, 255}, 0.60f, 0.00f, 1.00f, 0.14f, 0.55f, 0.08f, 0.80f},
+    // a full clear-coat lobe (the sharp window/softbox reflections) over a smoother lip lobe.
+    {"lip_gloss", RS_COSMETIC_LIP_GLOSS, {255, 255, 255}, 0.60f, 0.00f, 1.00f, 0.14f, 0.55f, 0.08f, 0.80f,
+     1.00f, 0.0f, 0.0f},
     // Eyeshadows: brown matte (the paper's Fig. 12), plum satin, champagne shimmer. Lid-sized brush.
-    {"eyeshadow_brown", RS_COSMETIC_EYESHADOW, {122, 82, 62}, 0.55f, 1.00f, 0.80f, 0.38f, 0.12f, 0.07f, 0.60f},
-    {"eyeshadow_plum", RS_COSMETIC_EYESHADOW, {112, 62, 92}, 0.55f, 1.00f, 0.80f, 0.30f, 0.20f, 0.07f, 0.60f},
-    {"eyeshadow_champagne", RS_COSMETIC_EYESHADOW, {222, 192, 152}, 0.55f, 0.80f, 1.00f, 0.22f, 0.40f, 0.07f, 0.60f},
-    // Eyeliner: near-black, very opaque, fine hard line; liquid liner dries to a soft sheen.
-    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.30f, 0.22f, 0.02f, 0.90f},
+    {"eyeshadow_brown", RS_COSMETIC_EYESHADOW, {122, 82, 62}, 0.55f, 1.00f, 0.80f, 0.38f, 0.12f, 0.07f, 0.60f,
+     0.0f, 0.0f, 0.30f},
+    {"eyeshadow_plum", RS_COSMETIC_EYESHADOW, {112, 62, 92}, 0.55f, 1.00f, 0.80f, 0.30f, 0.20f, 0.07f, 0.60f,
+     0.0f, 0.0f, 0.50f},
+    {"eyeshadow_champagne", RS_COSMETIC_EYESHADOW, {222, 192, 152}, 0.55f, 0.80f, 1.00f, 0.22f, 0.40f, 0.07f, 0.60f,
+     0.0f, 0.60f, 0.0f},
+    // Eyeliner: near-black, opaque (coverage 1: its black is not lifted to the face's darkest colour),
+    // fine hard line; liquid liner dries to a soft sheen (a faint coat).
+    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.30f, 0.22f, 0.02f, 0.90f,
+     0.15f, 0.0f, 1.00f},
 };
 
 uint32_t rs_cosmetic_count(void) { return (uint32_t)RS_COUNT_OF(presets); }
@@ -78,11 +95,57 @@ const char *rs_cosmetic_kind_name(rs_cosmetic_kind kind)
 
 static float clamp01(float x) { return isfinite(x) ? RS_CLAMP(x, 0.0f, 1.0f) : 0.0f; }
 
+// The finish families as (m, rho_s, coat, shimmer): matte and satin from the anchors above; gloss adds a
+// full clear coat to a smooth lobe; shimmer a smooth, bright lobe with flakes.
+static const float finishes[RS_FINISH_COUNT][4] = {
+    [RS_FINISH_MATTE] = {0.45f, 0.07f, 0.0f, 0.0f},
+    [RS_FINISH_SATIN] = {0.27f, 0.28f, 0.25f, 0.0f},
+    [RS_FINISH_GLOSS] = {0.14f, 0.55f, 1.0f, 0.0f},
+    [RS_FINISH_SHIMMER] = {0.21f, 0.45f, 0.0f, 0.8f},
+};
+static const char *const finish_names[RS_FINISH_COUNT] = {"matte", "satin", "gloss", "shimmer"};
+
+const char *rs_finish_name(rs_finish f) { return (unsigned)f < RS_FINISH_COUNT ? finish_names[f] : "unknown"; }
+
+bool rs_finish_parse(const char *name, rs_finish *out)
+{
+    for (int f = 0; f < RS_FINISH_COUNT; f++)
+        if (name && strcmp(name, finish_names[f]) == 0) {
+            *out = (rs_finish)f;
+            return true;
+        }
+    return false;
+}
+
+void rs_cosmetic_set_finish(rs_cosmetic *c, rs_finish f)
+{
+    if ((unsigned)f >= RS_FINISH_COUNT) return;
+    c->m = finishes[f][0];
+    c->rho_s = finishes[f][1];
+    c->coat = finishes[f][2];
+    c->shimmer = finishes[f][3];
+    c->finish_weight = 1.0f;
+}
+
+rs_finish rs_cosmetic_finish(const rs_cosmetic *c)
+{
+    rs_finish best = RS_FINISH_SATIN;
+    float best_d = INFINITY;
+    for (int f = 0; f < RS_FINISH_COUNT; f++) {
+        // rho_s and m span ~0.5 where coat and shimmer span 1: weigh them up so each axis counts alike.
+        float d[4] = {2.0f * (c->m - finishes[f][0]), 2.0f * (c->rho_s - finishes[f][1]), c->coat - finishes[f][2],
+                      c->shimmer - finishes[f][3]};
+        float dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + d[3] * d[3];
+        if (dd < best_d) best_d = dd, best = (rs_finish)f;
+    }
+    return best;
+}
+
 rs_cosmetic rs_cosmetic_custom(const uint8_t rgb[3], float material_weight, float m, float rho_s)
 {
     // Defaults of a medium blending brush; colour and finish at full weight.
     rs_cosmetic c = {"custom", RS_COSMETIC_CUSTOM, {rgb[0], rgb[1], rgb[2]}, clamp01(material_weight),
-                     1.0f, 1.0f, clamp01(m), clamp01(rho_s), 0.15f, 0.6f};
+                     1.0f, 1.0f, clamp01(m), clamp01(rho_s), 0.15f, 0.6f, 0.0f, 0.0f, 0.0f};
     return c;
 }
 
@@ -123,6 +186,7 @@ rs_result rs_cosmetic_validate(const rs_cosmetic *c, rs_error *err)
     const struct { const char *field; float v; } f[] = {
         {"material_weight", c->material_weight}, {"colour_weight", c->colour_weight},
         {"finish_weight", c->finish_weight}, {"m", c->m}, {"rho_s", c->rho_s}, {"opacity", c->opacity},
+        {"coat", c->coat}, {"shimmer", c->shimmer}, {"coverage", c->coverage},
     };
     for (size_t i = 0; i < RS_COUNT_OF(f); i++)
         if (!in01(f[i].v))
@@ -138,7 +202,8 @@ bool rs_cosmetic_equal(const rs_cosmetic *a, const rs_cosmetic *b)
     return strncmp(a->name, b->name, sizeof a->name) == 0 && a->kind == b->kind && a->rgb[0] == b->rgb[0] &&
            a->rgb[1] == b->rgb[1] && a->rgb[2] == b->rgb[2] && a->material_weight == b->material_weight &&
            a->colour_weight == b->colour_weight && a->finish_weight == b->finish_weight && a->m == b->m &&
-           a->rho_s == b->rho_s && a->size_rel == b->size_rel && a->opacity == b->opacity;
+           a->rho_s == b->rho_s && a->size_rel == b->size_rel && a->opacity == b->opacity && a->coat == b->coat &&
+           a->shimmer == b->shimmer && a->coverage == b->coverage;
 }
 
 // --- text form ---------------------------------------------------------------------------------------
@@ -147,12 +212,15 @@ int rs_cosmetic_format(const rs_cosmetic *c, char *buf, size_t cap)
 {
     const rs_cosmetic *preset = rs_cosmetic_find(c->name);
     if (preset && rs_cosmetic_equal(preset, c)) return snprintf(buf, cap, "%s", c->name);
+    char finish[96] = "";
+    if (c->coat != 0.0f || c->shimmer != 0.0f || c->coverage != 0.0f)
+        snprintf(finish, sizeof finish, " coat=%.9g shimmer=%.9g coverage=%.9g", c->coat, c->shimmer, c->coverage);
     return snprintf(buf, cap,
                     "custom name=%.*s kind=%s rgb=%u,%u,%u weight=%.9g colour=%.9g finish=%.9g m=%.9g rho_s=%.9g "
-                    "size=%.9g opacity=%.9g",
+                    "size=%.9g opacity=%.9g%s",
                     (int)strnlen(c->name, sizeof c->name), c->name, rs_cosmetic_kind_name(c->kind), c->rgb[0],
                     c->rgb[1], c->rgb[2], c->material_weight, c->colour_weight, c->finish_weight, c->m, c->rho_s,
-                    c->size_rel, c->opacity);
+                    c->size_rel, c->opacity, finish);
 }
 
 static bool parse_f(const char *s, float *out)
@@ -239,7 +307,8 @@ rs_result rs_cosmetic_parse(const char *text, rs_cosmetic *out, rs_error *err)
             struct { const char *key; float *field; bool *seen; } fields[] = {
                 {"weight", &c.material_weight, NULL}, {"colour", &c.colour_weight, NULL},
                 {"finish", &c.finish_weight, NULL}, {"m", &c.m, &have_m}, {"rho_s", &c.rho_s, &have_rho},
-                {"size", &c.size_rel, NULL}, {"opacity", &c.opacity, NULL},
+                {"size", &c.size_rel, NULL}, {"opacity", &c.opacity, NULL}, {"coat", &c.coat, NULL},
+                {"shimmer", &c.shimmer, NULL}, {"coverage", &c.coverage, NULL},
             };
             size_t k = 0;
             while (k < RS_COUNT_OF(fields) && strcmp(key, fields[k].key) != 0) k++;

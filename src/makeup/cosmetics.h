@@ -48,7 +48,27 @@ typedef struct rs_cosmetic {
     float rho_s;             // finish: specular scale target, 0..1
     float size_rel;          // default brush diameter as a fraction of the face height
     float opacity;           // default brush opacity (coverage per stroke)
+    // Finish layers over the skin's own lobe (blended in with the finish intensity, like m and rho_s):
+    float coat;              // clear-coat weight 0..1: a smooth, untinted second lobe (gloss; F0 0.04, m 0.1)
+    float shimmer;           // flake sparkle 0..1: tiny pigment-tinted mirrors that glint (highlighter)
+    float coverage;          // 0 sheer .. 1 opaque: an opaque pigment keeps its own colour (not held in the
+                             // face's range), hides the skin texture and reaches full intensity (eq. 3's 0.9
+                             // ceiling lifted to 1); docs/makeup.md
 } rs_cosmetic;
+
+// Finish families (docs/makeup.md): what a product editor offers. Each sets m, rho_s, coat, shimmer.
+typedef enum rs_finish {
+    RS_FINISH_MATTE = 0,     // rough, about half the skin's rho_s, no coat: dulls shine (powder)
+    RS_FINISH_SATIN,         // about the skin's own lobe plus a faint coat
+    RS_FINISH_GLOSS,         // smooth lobe and a full clear coat: sharp reflections of the surroundings
+    RS_FINISH_SHIMMER,       // smooth lobe and flakes
+    RS_FINISH_COUNT,
+} rs_finish;
+
+const char *rs_finish_name(rs_finish f);                    // "matte", "satin", "gloss", "shimmer"
+bool rs_finish_parse(const char *name, rs_finish *out);
+void rs_cosmetic_set_finish(rs_cosmetic *c, rs_finish f);  // keeps colour, weights, brush
+rs_finish rs_cosmetic_finish(const rs_cosmetic *c);         // the family nearest to c's finish
 
 uint32_t rs_cosmetic_count(void);
 // Preset i (0 <= i < rs_cosmetic_count()), in UI order; NULL when out of range.
@@ -69,7 +89,8 @@ rs_result rs_cosmetic_validate(const rs_cosmetic *c, rs_error *err);
 bool rs_cosmetic_equal(const rs_cosmetic *a, const rs_cosmetic *b);
 
 // Text form used by stroke and look files (docs/makeup.md): a preset's name when c equals that preset,
-// else "custom name=N kind=K rgb=R,G,B weight=W colour=C finish=F m=M rho_s=S size=Z opacity=O"
+// else "custom name=N kind=K rgb=R,G,B weight=W colour=C finish=F m=M rho_s=S size=Z opacity=O
+// coat=G shimmer=H coverage=V" (the last three only when non-zero)
 // (floats printed to round-trip exactly). Returns what snprintf returns.
 int rs_cosmetic_format(const rs_cosmetic *c, char *buf, size_t cap);
 // Parses that form (NUL-terminated, one line). "custom" needs rgb= or hsv=H,S,V plus m= and rho_s=;

@@ -257,21 +257,23 @@ static uint8_t to_srgb8(const colour_tables *t, float x)
 
 // A cosmetic prepared for composing: colour in linear light, weights clamped.
 typedef struct prepared {
-    float lin[3], colour_w, finish_w, m, rho_s, material_w;
+    float lin[3], colour_w, finish_w, m, rho_s, material_w, coat, shimmer, coverage;
 } prepared;
 
 static prepared prepare(const colour_tables *t, const rs_cosmetic *c)
 {
     prepared p = {{t->to_lin[c->rgb[0]], t->to_lin[c->rgb[1]], t->to_lin[c->rgb[2]]},
                   clamp01(c->colour_weight), clamp01(c->finish_weight), clamp01(c->m), clamp01(c->rho_s),
-                  clamp01(c->material_weight)};
+                  clamp01(c->material_weight), clamp01(c->coat), clamp01(c->shimmer), clamp01(c->coverage)};
     return p;
 }
 
 static void compose(const colour_tables *t, rs_makeup_gpu *rec, const prepared *c, float amount, uint8_t detail)
 {
     float a = clamp01(amount);
-    float i2 = a * c->colour_w;
+    // Eq. (3) tops out at 0.9 (three terms of 0.3): right for sheer products, which never hide the skin.
+    // Coverage lifts that ceiling to 1 for an opaque product (a liner, a full-coverage lipstick).
+    float i2 = RS_MIN(a * c->colour_w * (1.0f + c->coverage * (1.0f / 0.9f - 1.0f)), 1.0f);
     if (i2 > 0.0f) {
         // eq. (2) stacked: I' = 1 - (1-I1)(1-I2), Cp' = (Cp1 I1 (1-I2) + Cp2 I2) / I', linear light.
         float i1 = rec->colour_i / 255.0f;
@@ -282,6 +284,7 @@ static void compose(const colour_tables *t, rs_makeup_gpu *rec, const prepared *
                 float cp = (t->to_lin[rec->rgb[ch]] * i1 * (1.0f - i2) + c->lin[ch] * i2) / ii;
                 rec->rgb[ch] = to_srgb8(t, cp);
             }
+            rec->coverage = q255(((rec->coverage / 255.0f) * i1 * (1.0f - i2) + c->coverage * i2) / ii);
             rec->colour_i = q;
             rec->flags = detail;
         }
@@ -294,6 +297,8 @@ static void compose(const colour_tables *t, rs_makeup_gpu *rec, const prepared *
         if (q > 0) {
             rec->m = q255(((rec->m / 255.0f) * s1 * (1.0f - s2) + c->m * s2) / ss);
             rec->rho_s = q255(((rec->rho_s / 255.0f) * s1 * (1.0f - s2) + c->rho_s * s2) / ss);
+            rec->coat = q255(((rec->coat / 255.0f) * s1 * (1.0f - s2) + c->coat * s2) / ss);
+            rec->shimmer = q255(((rec->shimmer / 255.0f) * s1 * (1.0f - s2) + c->shimmer * s2) / ss);
             rec->spec_i = q;
         }
     }
@@ -313,8 +318,8 @@ void rs_makeup_erase(rs_makeup_gpu *rec, float amount)
     rec->colour_i = (uint8_t)lrintf(rec->colour_i * keep);
     rec->spec_i = (uint8_t)lrintf(rec->spec_i * keep);
     // Keep records canonical: a part with no intensity carries no values, so a full erase is all zero.
-    if (rec->colour_i == 0) rec->rgb[0] = rec->rgb[1] = rec->rgb[2] = rec->flags = 0;
-    if (rec->spec_i == 0) rec->m = rec->rho_s = 0;
+    if (rec->colour_i == 0) rec->rgb[0] = rec->rgb[1] = rec->rgb[2] = rec->flags = rec->coverage = 0;
+    if (rec->spec_i == 0) rec->m = rec->rho_s = rec->coat = rec->shimmer = 0;
 }
 
 void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, float albedo_lin[3], float *m,
@@ -323,10 +328,14 @@ void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, 
     // Same operations in the same order as rs_makeup_apply in shaders_es/makeup.glsl.
     float ci = rec->colour_i / 255.0f;
     if (ci > 0.0f) {
-        float detail = rec->flags / 128.0f;
+        // Coverage: an opaque pigment keeps its own colour (not held in the face's range) and hides the
+        // skin's texture; a sheer one is held and lets the texture through (docs/makeup.md).
+        float cov = rec->coverage / 255.0f;
+        float detail = (rec->flags / 128.0f) * (1.0f - cov) + cov;
         for (int ch = 0; ch < 3; ch++) {
             float cp = rs_srgb_to_linear(rec->rgb[ch] / 255.0f);
-            float pig = RS_MIN(RS_CLAMP(cp, u->range_lo[ch], u->range_hi[ch]) * detail, 1.0f);
+            float held = RS_CLAMP(cp, u->range_lo[ch], u->range_hi[ch]);
+            float pig = RS_MIN((held * (1.0f - cov) + cp * cov) * detail, 1.0f);
             albedo_lin[ch] = albedo_lin[ch] * (1.0f - ci) + pig * ci;  // eq. (2)
         }
     }
@@ -335,6 +344,13 @@ void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, 
         *m = *m * (1.0f - si) + (rec->m / 255.0f) * si;
         *rho_s = *rho_s * (1.0f - si) + (rec->rho_s / 255.0f) * si;
     }
+}
+
+void rs_makeup_layers_cpu(const rs_makeup_gpu *rec, float *coat, float *shimmer)
+{
+    float si = rec->spec_i / 255.0f;
+    *coat = (rec->coat / 255.0f) * si;
+    *shimmer = (rec->shimmer / 255.0f) * si;
 }
 
 // --- grid ------------------------------------------------------------------------------------------

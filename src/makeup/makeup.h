@@ -1,7 +1,7 @@
 // makeup.h — the makeup layer: per-splat cosmetic colour, intensity and finish over the untouched base
 // skin, painted by brush stamps (paper §3.1, §3.3, eqs. 2-3).
 //
-// Does: hold one 8-byte GPU record per splat (same order as the cloud) plus touch counts; gather the
+// Does: hold one 12-byte GPU record per splat (same order as the cloud) plus touch counts; gather the
 // splats within a brush radius through a uniform grid built once per cloud; apply a stamp (eq. 3
 // intensity, eq. 2 blend composed exactly into one record), an eraser, mirror stamps across the face's
 // mid-plane, a per-stroke opacity cap; undo/redo per stroke; clear; report the dirty index range so the
@@ -25,9 +25,10 @@
 #include "makeup/cosmetics.h"
 #include "splat/splat.h"
 
-// The GPU record, one per splat, uploaded as a uvec2 per-instance attribute. Byte order in memory is
+// The GPU record, one per splat, uploaded as a uvec3 per-instance attribute. Byte order in memory is
 // the field order, so on the (little-endian) GPU: x = r | g << 8 | b << 16 | colour_i << 24,
-// y = m | rho_s << 8 | spec_i << 16 | flags << 24. All zero = no makeup: the base is drawn exactly.
+// y = m | rho_s << 8 | spec_i << 16 | flags << 24, z = coat | shimmer << 8 | coverage << 16. All zero = no
+// makeup: the base is drawn exactly.
 typedef struct rs_makeup_gpu {
     uint8_t rgb[3];     // composed cosmetic colour Cp, sRGB8
     uint8_t colour_i;   // colour intensity I of eq. (2), q/255
@@ -35,6 +36,10 @@ typedef struct rs_makeup_gpu {
     uint8_t rho_s;      // composed finish specular scale, q/255
     uint8_t spec_i;     // finish intensity (how much m/rho_s replace the base's), q/255
     uint8_t flags;      // skin detail ratio L_base / L_local, q/128 (set while colour_i > 0; see makeup.c)
+    uint8_t coat;       // composed clear-coat weight, q/255 (applies with spec_i, like m and rho_s)
+    uint8_t shimmer;    // composed flake weight, q/255 (likewise)
+    uint8_t coverage;   // composed coverage, q/255 (applies with colour_i: how opaque the pigment is)
+    uint8_t reserved;   // 0 (keeps the record a whole number of uint32 words)
 } rs_makeup_gpu;
 
 // Half-open range of splat indices [lo, hi); empty when lo >= hi.
@@ -176,5 +181,7 @@ void rs_makeup_erase(rs_makeup_gpu *rec, float amount);
 // CPU mirror of rs_makeup_apply in shaders_es/makeup.glsl (same operations, same order).
 void rs_makeup_apply_cpu(const rs_makeup_gpu *rec, const rs_makeup_uniforms *u, float albedo_lin[3], float *m,
                          float *rho_s);
+// The finish layers a record puts on a splat (bare skin has none): clear-coat and flake weights, 0..1.
+void rs_makeup_layers_cpu(const rs_makeup_gpu *rec, float *coat, float *shimmer);
 
 #endif

@@ -93,6 +93,7 @@ static rs_view view_resolved(const rs_view *in)
     if (v.exposure <= 0) v.exposure = 1.0f;
     if (v.rho_s_scale <= 0) v.rho_s_scale = 1.0f;
     if (!(v.lod_density > 0)) v.lod_density = RS_LOD_DENSITY_DEFAULT;
+    if (!(v.env_intensity > 0)) v.env_intensity = 1.0f;
     if (v.key.intensity <= 0) v.key.intensity = 1.0f;
     rs_light *lights[2] = {&v.key, &v.fill};
     for (int i = 0; i < 2; i++)
@@ -207,13 +208,37 @@ void rs_render_frame_setup(const rs_renderer *r, const rs_view *view, rs_frame *
     f->lit = m == RS_MODE_FULL || m == RS_MODE_DIFFUSE || m == RS_MODE_SPECULAR || m == RS_MODE_SHADOW ||
              m == RS_MODE_IRRADIANCE;
     f->diffuse = m == RS_MODE_FULL || m == RS_MODE_DIFFUSE;
-    f->lean_attributes = f->mobile && m != RS_MODE_REGIONS && m != RS_MODE_LOD && r->float_rt;
     f->shadows = f->lit && !v->no_shadows;
 
     const rs_splat_header *h = &r->cloud->hdr;
     vec3 d;
     mat3 rot;
     glm_mat4_pick3(f->cam.view, rot);
+    f->env_on = f->lit && v->lighting == RS_LIGHTING_ENV && r->env.on;
+    if (f->env_on) {
+        // The environment's frame is the face frame (x right = the subject's left, y up, z forward)
+        // turned by env_rotate_deg about up. Its brightest region is the key light.
+        vec3 right, up, fwd;
+        frame_dir(h, 90.0f, 0.0f, right);
+        frame_dir(h, 0.0f, 90.0f, up);
+        frame_dir(h, 0.0f, 0.0f, fwd);
+        float a = DEG2RAD(v->env_rotate_deg), ca = cosf(a), sa = sinf(a);
+        // Face-frame coordinates -> environment coordinates: a turn by -a about y.
+        mat3 face_to_env = {{ca, 0, sa}, {0, 1, 0}, {-sa, 0, ca}};
+        mat3 model_to_face = {{right[0], up[0], fwd[0]}, {right[1], up[1], fwd[1]}, {right[2], up[2], fwd[2]}};
+        mat3 inv_rot, m2;
+        glm_mat4_pick3(f->cam.inv_view, inv_rot);
+        glm_mat3_mul(model_to_face, inv_rot, m2);
+        glm_mat3_mul(face_to_env, m2, f->env_from_view);
+        // The light back: environment -> view is the transpose (all rotations).
+        mat3 view_from_env;
+        glm_mat3_transpose_to(f->env_from_view, view_from_env);
+        glm_mat3_mulv(view_from_env, (float *)r->env.light_dir, f->key_dir);
+        glm_vec3_normalize(f->key_dir);
+        glm_vec3_scale((float *)r->env.light_color, v->env_intensity, f->key_color);
+        f->key_widen = 0.5f * r->env.light_angle;
+        return;
+    }
     frame_dir(h, v->key.yaw_deg, v->key.pitch_deg, d);
     glm_mat3_mulv(rot, d, f->key_dir);
     glm_vec3_scale((float *)v->key.color, v->key.intensity, f->key_color);
@@ -257,7 +282,6 @@ static const char *const prog_files[RS_PROG_COUNT][2] = {
     [RS_PROG_VISIBILITY] = {"visibility.vert.glsl", "visibility.frag.glsl"},
     [RS_PROG_PICK] = {"visibility.vert.glsl", "visibility.frag.glsl"},
     [RS_PROG_ATTRIBUTE] = {"attribute.vert.glsl", "attribute.frag.glsl"},
-    [RS_PROG_ATTRIBUTE_LEAN] = {"attribute.vert.glsl", "attribute.frag.glsl"},
     [RS_PROG_DIFFUSION] = {"diffusion.vert.glsl", "diffusion.frag.glsl"},
     [RS_PROG_RESOLVE] = {"fullscreen.vert.glsl", "diffusion_resolve.frag.glsl"},
     [RS_PROG_COMPOSITE] = {"fullscreen.vert.glsl", "composite.frag.glsl"},
@@ -267,7 +291,6 @@ static const char *const prog_files[RS_PROG_COUNT][2] = {
 static const char *const prog_defines[RS_PROG_COUNT] = {
     [RS_PROG_SHADOW] = "#define RS_SHADOW 1\n",
     [RS_PROG_PICK] = "#define RS_PICK 1\n",
-    [RS_PROG_ATTRIBUTE_LEAN] = "#define RS_ATTR_LEAN 1\n",
 };
 
 rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *out, rs_error *err)
@@ -312,6 +335,9 @@ rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *ou
     glUniform1i(rs_uloc(p, "u_attr2"), RS_UNIT_ATTR2);
     glUniform1i(rs_uloc(p, "u_diffuse"), RS_UNIT_DIFFUSE);
     glUniform1i(rs_uloc(p, "u_level"), RS_UNIT_LEVEL);
+    glUniform1i(rs_uloc(p, "u_env_map"), RS_UNIT_ENV);
+    glUniform1i(rs_uloc(p, "u_spec_lut"), RS_UNIT_SPEC_LUT);
+    glUniform1f(rs_uloc(p, "u_has_ao"), (h->flags & RS_SPLAT_FLAG_AO) ? 1.0f : 0.0f);
     r->prog[kind][q] = p;
     *out = p;
     return RS_OK;
@@ -361,7 +387,7 @@ static void setup_vao(rs_renderer *r, GLuint vao, GLuint divisor, bool feedback)
     glVertexAttribDivisor(2, divisor);
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_makeup);
     glEnableVertexAttribArray(1);
-    glVertexAttribIPointer(1, 2, GL_UNSIGNED_INT, 8, (void *)0);
+    glVertexAttribIPointer(1, 3, GL_UNSIGNED_INT, (GLsizei)sizeof(rs_makeup_gpu), (void *)0);
     glVertexAttribDivisor(1, divisor);
     glBindVertexArray(0);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
@@ -390,7 +416,7 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
         return rs_fail(err, RS_ERR_ARG, "render: the cloud's face_height and mm_per_unit must be > 0");
     size_t bytes_splats, bytes_makeup;
     if (!rs_size_mul(c->hdr.count, sizeof(rs_splat_packed), &bytes_splats) ||
-        !rs_size_mul(c->hdr.count, 8, &bytes_makeup) || bytes_splats > (size_t)INT32_MAX)
+        !rs_size_mul(c->hdr.count, sizeof(rs_makeup_gpu), &bytes_makeup) || bytes_splats > (size_t)INT32_MAX)
         return rs_fail(err, RS_ERR_LIMIT, "render: %u splats do not fit a GL buffer", c->hdr.count);
     rs_renderer *r = calloc(1, sizeof *r);
     void *zeros = calloc(1, bytes_makeup);
@@ -470,6 +496,7 @@ void rs_render_destroy(rs_renderer *r)
     release_targets(r);
     rs_render_shadow_release(r);
     rs_render_pick_release(r);
+    rs_render_env_release(r);
     for (int k = 0; k < RS_PROG_COUNT; k++)
         for (int q = 0; q < 2; q++)
             if (r->prog[k][q]) glDeleteProgram(r->prog[k][q]);
@@ -586,7 +613,8 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
                        RS_VIEW_FOV_MIN_DEG, RS_VIEW_FOV_MAX_DEG);
     const float nums[] = {view->yaw_deg, view->pitch_deg, view->zoom, view->pan[0], view->pan[1], view->exposure,
                           view->ambient, view->rho_s_scale, view->key.yaw_deg, view->key.pitch_deg,
-                          view->key.intensity, view->fill.yaw_deg, view->fill.pitch_deg, view->fill.intensity};
+                          view->key.intensity, view->fill.yaw_deg, view->fill.pitch_deg, view->fill.intensity,
+                          view->env_rotate_deg, view->env_intensity};
     for (size_t i = 0; i < RS_COUNT_OF(nums); i++)
         if (!isfinite(nums[i]) || fabsf(nums[i]) > 1e6f)
             return rs_fail(err, RS_ERR_ARG, "render: view parameter %zu is %g (not a finite, sane number)", i,
@@ -741,7 +769,8 @@ rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count
     if (count == 0) return RS_OK;
     if (!records) return rs_fail(err, RS_ERR_ARG, "render: makeup records missing");
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_makeup);
-    glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)first * 8, (GLsizeiptr)count * 8, records);
+    glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)first * (GLintptr)sizeof(rs_makeup_gpu),
+                    (GLsizeiptr)count * (GLsizeiptr)sizeof(rs_makeup_gpu), records);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     return rs_gl_check("render: makeup upload", err);
 }

@@ -1,7 +1,7 @@
 // render.h — the splat renderer: the paper's five stages (shadow map, visibility splatting, attribute
 // splatting, splat-based diffusion, composite F = A(D + S)) in a reference and a mobile pipeline.
 //
-// Does: upload a splat cloud (the packed 16-byte records, as is) and its makeup layer (8-byte records);
+// Does: upload a splat cloud (the packed 16-byte records, as is) and its makeup layer (12-byte records);
 // render a view into the renderer's own RGBA8 output texture (headless and windowed alike); read it
 // back; pick the splat under a pixel through an ID buffer; update makeup records by sub-range.
 // Does not: create the GL context (gl/gl.h), handle input, or own the makeup layer's CPU state.
@@ -20,6 +20,7 @@
 #include "core/core.h"
 #include "gl/gl.h"
 #include "core/image.h"
+#include "formats/env.h"
 #include "makeup/makeup.h"
 #include "splat/splat.h"
 
@@ -45,8 +46,9 @@ typedef enum rs_pipeline {
 } rs_pipeline;
 
 typedef enum rs_composite {
-    RS_COMPOSITE_PAPER = 0,     // F = A (D + S), paper eq. 1
-    RS_COMPOSITE_PHYSICAL,      // F = A D + S (specular not tinted by albedo)
+    RS_COMPOSITE_DEFAULT = 0,   // PAPER under the paper's lights, PHYSICAL under an environment
+    RS_COMPOSITE_PAPER,         // F = A (D + S), paper eq. 1
+    RS_COMPOSITE_PHYSICAL,      // F = A D + S (specular not tinted by albedo: a dielectric's white highlight)
 } rs_composite;
 
 typedef enum rs_splat_prim {
@@ -54,6 +56,20 @@ typedef enum rs_splat_prim {
     RS_PRIM_POINTS,
     RS_PRIM_QUADS,              // instanced screen-aligned quads
 } rs_splat_prim;
+
+// Where the light comes from (rs_view.lighting).
+typedef enum rs_lighting {
+    RS_LIGHTING_ENV = 0,        // the renderer's environment (rs_render_set_env): its brightest region as
+                                // the shadowed key light, the rest as SH irradiance and prefiltered
+                                // radiance; without one, the lights below
+    RS_LIGHTING_LIGHTS,         // key + fill + ambient only (the paper's single lamp: `--env paper`)
+} rs_lighting;
+
+typedef enum rs_tonemap {
+    RS_TONEMAP_DEFAULT = 0,     // CLAMP under the paper's lights, FILMIC under an environment
+    RS_TONEMAP_FILMIC,          // ACES filmic fit after exposure: HDR light rolls off instead of clipping
+    RS_TONEMAP_CLAMP,           // exposure then clamp to 0..1 (the paper's figures)
+} rs_tonemap;
 
 typedef struct rs_light {
     float yaw_deg, pitch_deg;   // direction the light comes FROM, in the face frame (0,0 = from the front)
@@ -85,6 +101,10 @@ typedef struct rs_view {
                                 // levels (4x) below max_splats (0: default 0.3; docs/mobile.md)
     rs_splat_prim prim;         // primitive choice (AUTO by caps)
     float ambient;              // uniform sky irradiance added to every splat (linear, unshadowed); 0: none
+    rs_lighting lighting;       // ENV (default): key, fill and ambient above are ignored when an environment is set
+    float env_rotate_deg;       // the environment turned about the face's up axis (+: its light moves like +yaw)
+    float env_intensity;        // multiplies the environment (after its normalisation); 0 means 1
+    rs_tonemap tonemap;
     bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)
 } rs_view;
 
@@ -147,7 +167,7 @@ void rs_render_view_dir(const rs_renderer *r, const rs_view *view, const float p
 // Projects a model-space point to pixels (top-left origin); false when behind the camera.
 bool rs_render_project(const rs_renderer *r, const rs_view *view, const float pos[3], float px[2]);
 
-// Makeup layer records (rs_makeup_gpu, 8 bytes each) for splats [first, first + count).
+// Makeup layer records (rs_makeup_gpu, 12 bytes each) for splats [first, first + count).
 rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count, const void *records,
                                   rs_error *err);
 
@@ -156,6 +176,12 @@ rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count
 void rs_render_set_makeup_uniforms(rs_renderer *r, const rs_makeup_uniforms *u);
 
 rs_render_stats rs_render_get_stats(const rs_renderer *r);
+
+// Uploads a lighting environment (formats/env.h; not kept: the renderer copies what it needs) that views
+// with lighting RS_LIGHTING_ENV use; NULL removes it. Its exposure is normalised so that every
+// environment lights the front of the face about equally (render_env.c).
+rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err);
+bool rs_render_has_env(const rs_renderer *r);
 
 // Splats the main passes would draw for this view: the max_splats cap, and in the mobile pipeline the
 // LOD prefix chosen by lod_density from the face's screen area (cheap: a few thousand dot products).

@@ -1,6 +1,7 @@
 // render_attribute.c — stage 3, attribute splatting (paper Fig. 2): the splats again, depth-tested (LEQUAL,
 // no writes) against stage 2, their Gaussian-weighted attributes added into three targets:
-//   RT0 = (albedo, 1) w,  RT1 = (normal * 0.5 + 0.5, m) w,  RT2 = (rho_s, debug colour) w.
+//   RT0 = (albedo, 1) w,  RT1 = (normal * 0.5 + 0.5, m) w,
+//   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w (the debug views: (rho_s, debug colour) w).
 // w = exp(-l^2 / (2 sigma^2)) with l the hit's distance from the disk centre in radii.
 // Targets are RGBA16F when the driver can blend into half floats (EXT_color_buffer_half_float/_float).
 // Fallback without them: RGBA8 with every weight scaled by RS_ATTR_WEIGHT_SCALE_RGBA8 (1/5) so the sums of
@@ -43,14 +44,13 @@ static void lod_palette(int levels, float out[24][3])
 rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
 {
     GLuint prog;
-    rs_result res = rs_render_program(r, f->lean_attributes ? RS_PROG_ATTRIBUTE_LEAN : RS_PROG_ATTRIBUTE, f->quads,
-                                      &prog, err);
+    rs_result res = rs_render_program(r, RS_PROG_ATTRIBUTE, f->quads, &prog, err);
     if (res != RS_OK) return res;
     const rs_camera *cam = &f->cam;
     const rs_splat_header *h = &r->cloud->hdr;
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_attr);
     glViewport(0, 0, cam->width, cam->height);
-    int targets = f->lean_attributes ? 2 : 3;
+    const int targets = 3;
     const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     glDrawBuffers(targets, bufs);
     const GLfloat zero[4] = {0, 0, 0, 0};

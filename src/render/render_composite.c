@@ -1,7 +1,8 @@
 // render_composite.c — stage 5 (paper Fig. 2, eq. 1): a full-screen pass that normalises the attribute
 // sums, evaluates the Kelemen/Szirmay-Kalos specular S per pixel, reads D from stage 4 and writes
-// F = A (D + S) (RS_COMPOSITE_PAPER, the default: the paper's composite, which tints the highlight by
-// the skin colour) or F = A D + S (RS_COMPOSITE_PHYSICAL: a dielectric's white highlight), then exposure
+// F = A (D + S) (RS_COMPOSITE_PAPER, the default under the paper's lights: the paper's composite, which
+// tints the highlight by the skin colour) or F = A D + S (RS_COMPOSITE_PHYSICAL, the default under an
+// environment: a dielectric's white highlight), plus the makeup's clear coat and flakes; then exposure
 // and sRGB into the RGBA8 output. The debug views are branches of the same pass.
 #include "render/render_internal.h"
 
@@ -24,8 +25,17 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform2f(rs_uloc(prog, "u_viewport"), (float)cam->width, (float)cam->height);
     glUniform1f(rs_uloc(prog, "u_eps"), f->eps);
     glUniform1i(rs_uloc(prog, "u_mode"), (int)v->mode);
-    glUniform1i(rs_uloc(prog, "u_lean"), f->lean_attributes ? 1 : 0);
-    glUniform1i(rs_uloc(prog, "u_physical"), v->composite == RS_COMPOSITE_PHYSICAL ? 1 : 0);
+    glUniform1f(rs_uloc(prog, "u_key_widen"), f->key_widen);
+    bool filmic = v->tonemap == RS_TONEMAP_FILMIC || (v->tonemap == RS_TONEMAP_DEFAULT && f->env_on);
+    glUniform1i(rs_uloc(prog, "u_tonemap"), filmic ? 0 : 1);
+    glUniformMatrix4fv(rs_uloc(prog, "u_inv_view"), 1, GL_FALSE, (const float *)cam->inv_view);
+    // Flakes of ~0.3 mm: a few pixels each in a close-up, about one per pixel in a full-face view.
+    glUniform1f(rs_uloc(prog, "u_flake_size"), 0.3f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
+    rs_render_env_uniforms(r, f, prog);
+    // Under an environment the highlight is what skin's surface reflects, white (a dielectric); the
+    // paper's A (D + S) tints it with the albedo, which the paper's figures keep.
+    bool physical = v->composite == RS_COMPOSITE_PHYSICAL || (v->composite == RS_COMPOSITE_DEFAULT && f->env_on);
+    glUniform1i(rs_uloc(prog, "u_physical"), physical ? 1 : 0);
     glUniform1f(rs_uloc(prog, "u_exposure"), v->exposure);
     glUniform1f(rs_uloc(prog, "u_linear_output"), v->linear_output ? 1.0f : 0.0f);
     // The background is given in sRGB; linear output shows it linear too.
@@ -53,6 +63,6 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
-    for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_LEVEL; i++) rs_render_bind_texture(i, 0);
+    for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_SPEC_LUT; i++) rs_render_bind_texture(i, 0);
     return RS_OK;
 }

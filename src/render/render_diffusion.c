@@ -238,6 +238,7 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     glUniform3fv(rs_uloc(prog, "u_ambient"), 1, f->ambient);
     glUniform1f(rs_uloc(prog, "u_reach"), reach);
     rs_render_shadow_uniforms(r, f, prog);
+    rs_render_env_uniforms(r, f, prog);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
     glBindVertexArray(r->vao_feedback);
     glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, r->vbo_irradiance);

@@ -6,6 +6,7 @@
 #ifndef RS_RENDER_INTERNAL_H
 #define RS_RENDER_INTERNAL_H
 
+#include "formats/env.h"
 #include "render/profile.h"
 #include "render/render.h"
 
@@ -17,7 +18,6 @@ typedef enum rs_prog {
     RS_PROG_VISIBILITY,
     RS_PROG_PICK,
     RS_PROG_ATTRIBUTE,
-    RS_PROG_ATTRIBUTE_LEAN,  // two targets instead of three (the mobile pipeline's lit modes)
     RS_PROG_DIFFUSION,
     RS_PROG_SPLAT_COUNT,
     RS_PROG_RESOLVE = RS_PROG_SPLAT_COUNT,
@@ -35,7 +35,21 @@ enum {
     RS_UNIT_ATTR2,
     RS_UNIT_DIFFUSE,     // D (u_diffuse)
     RS_UNIT_LEVEL,       // one diffusion level's accumulation (u_level)
+    RS_UNIT_ENV,         // the environment's prefiltered radiance (u_env_map)
+    RS_UNIT_SPEC_LUT,    // the specular lobe's directional albedo (u_spec_lut)
 };
+
+// The environment as uploaded (render_env.c): radiance and SH scaled by the exposure normalisation.
+typedef struct rs_render_env {
+    bool on;
+    float scale;                 // exposure normalisation (mean front irradiance -> a fixed target)
+    float sh[9][3];
+    float light_dir[3];          // environment frame, towards the light
+    float light_color[3];
+    float light_angle;           // radians
+    int levels;
+    float level_m[RS_ENV_MAX_LEVELS];
+} rs_render_env;
 
 // Disks are drawn (visibility, attributes, shadow map, ID buffer) out to RS_COVERAGE radii; the
 // attribute weight stays a Gaussian of the distance in radii, so the extra rim only matters where nothing
@@ -120,7 +134,9 @@ typedef struct rs_frame {
     mat4 shadow_matrix;      // view space -> light clip space
     float shadow_bias, shadow_offset, shadow_texel;
     float delta_weight[3];   // profile weight taken by per-pixel irradiance (stage 4's narrow Gaussians)
-    bool lean_attributes;    // stage 3 writes two targets: RT1 = (normal.xy, m, rho_s) (render_attribute.c)
+    bool env_on;             // lit by the renderer's environment (its light is then the key light)
+    mat3 env_from_view;      // view-space directions -> the environment's frame (rotation included)
+    float key_widen;         // half the key light's angular radius, radians (0: a point light)
 } rs_frame;
 
 struct rs_renderer {
@@ -155,6 +171,9 @@ struct rs_renderer {
     bool pick_valid;
 
     rs_makeup_uniforms makeup_uni;  // makeup.glsl's colour range
+
+    rs_render_env env;          // render_env.c
+    GLuint env_tex, lut_tex;
 
     // Mobile profile cache, one per K (a fit takes milliseconds to tens of milliseconds).
     rs_profile fit[RS_PROFILE_FIT_MAX + 1];
@@ -191,6 +210,9 @@ rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffus
                               rs_error *err);
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err);
 void rs_render_pick_release(rs_renderer *r);
+// render_env.c: the env_light.glsl uniforms and textures for the frame.
+void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
+void rs_render_env_release(rs_renderer *r);
 void rs_render_shadow_release(rs_renderer *r);
 void rs_render_level_release(rs_renderer *r);
 

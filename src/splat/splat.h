@@ -20,6 +20,7 @@
 #define RS_SPLAT_MAX_REGIONS 16
 #define RS_SPLAT_MAX_NOTES 8192         // attribution / provenance text carried from the source scan
 #define RS_SPLAT_MAX_COUNT (64u << 20)  // 64M splats: far above any face scan, keeps sizes in 32 bits
+#define RS_SPLAT_FLAG_AO (1u << 0)      // header flag: byte 15 of every record is its ambient occlusion
 
 // Built-in region ids (the region table may add more after these).
 typedef enum rs_region {

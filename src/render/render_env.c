@@ -1,0 +1,173 @@
+// render_env.c — the lighting environment on the GPU: its prefiltered radiance (one RGB9E5 texture whose
+// mip levels are the roughness levels), its SH irradiance and dominant light (uniforms), the exposure
+// normalisation that makes every environment light the face about as brightly, and the lookup table of
+// the specular lobe's directional albedo that turns prefiltered radiance into reflected light (split sum).
+#include "render/render_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define LUT_SIZE 32
+#define LUT_SAMPLES 512
+// Linear RGB -> luminance (Rec. 709).
+#define LUM(c) (0.2126f * (c)[0] + 0.7152f * (c)[1] + 0.0722f * (c)[2])
+// What the normalisation aims at: the mean irradiance over the front-facing half of the normals.
+#define ENV_TARGET_FRONT 0.5f
+
+// Directional albedo of the lobe S = (N.L) P_H F / |L + V|^2 (rho_s 1) over the hemisphere, divided by pi
+// as every light in the renderer is (a white Lambertian surface under irradiance E reflects E): F0 A + B.
+// Importance-sampled with Beckmann half vectors: with pdf(L) = P_H (N.H) / (4 pi V.H) and |L + V|^2 =
+// 4 (V.H)^2, each sample weighs (N.L) F / ((V.H) (N.H)). Hammersley points: the table is the same on every
+// machine.
+static void lobe_albedo(float ndotv, float m, float *a, float *b)
+{
+    float V[3] = {sqrtf(RS_MAX(1.0f - ndotv * ndotv, 0.0f)), 0.0f, ndotv};
+    double sa = 0.0, sb = 0.0;
+    for (uint32_t i = 0; i < LUT_SAMPLES; i++) {
+        float u1 = ((float)i + 0.5f) / LUT_SAMPLES;
+        uint32_t bits = i;
+        bits = (bits << 16) | (bits >> 16);
+        bits = ((bits & 0x55555555u) << 1) | ((bits & 0xAAAAAAAAu) >> 1);
+        bits = ((bits & 0x33333333u) << 2) | ((bits & 0xCCCCCCCCu) >> 2);
+        bits = ((bits & 0x0F0F0F0Fu) << 4) | ((bits & 0xF0F0F0F0u) >> 4);
+        bits = ((bits & 0x00FF00FFu) << 8) | ((bits & 0xFF00FF00u) >> 8);
+        float u2 = (float)bits * 2.3283064365386963e-10f;
+        // Beckmann: tan^2(theta_h) = -m^2 ln(1 - u).
+        float t2 = -m * m * logf(1.0f - u1);
+        float ch = 1.0f / sqrtf(1.0f + t2), sh = sqrtf(RS_MAX(1.0f - ch * ch, 0.0f));
+        float phi = 6.2831853f * u2;
+        float H[3] = {sh * cosf(phi), sh * sinf(phi), ch};
+        float vh = V[0] * H[0] + V[1] * H[1] + V[2] * H[2];
+        if (vh <= 0.0f) continue;
+        float L[3] = {2.0f * vh * H[0] - V[0], 2.0f * vh * H[1] - V[1], 2.0f * vh * H[2] - V[2]};
+        float nl = L[2];
+        if (nl <= 0.0f) continue;
+        float w = nl / (vh * ch);
+        float e = powf(1.0f - vh, 5.0f);
+        sa += w * (1.0f - e);
+        sb += w * e;
+    }
+    *a = (float)(sa / LUT_SAMPLES);
+    *b = (float)(sb / LUT_SAMPLES);
+}
+
+static rs_result make_lut(rs_renderer *r, rs_error *err)
+{
+    if (r->lut_tex) return RS_OK;
+    float *t = malloc(sizeof(float) * 2 * LUT_SIZE * LUT_SIZE);
+    if (!t) return rs_fail(err, RS_ERR_NOMEM, "render: out of memory (specular table)");
+    for (int j = 0; j < LUT_SIZE; j++)       // m at texel centres over 0..1 (the shader clamps m >= 0.02)
+        for (int i = 0; i < LUT_SIZE; i++) { // N.V likewise
+            float ndotv = RS_MAX(((float)i + 0.5f) / LUT_SIZE, 1e-3f);
+            float m = RS_MAX(((float)j + 0.5f) / LUT_SIZE, 0.02f);
+            lobe_albedo(ndotv, m, &t[2 * (j * LUT_SIZE + i)], &t[2 * (j * LUT_SIZE + i) + 1]);
+        }
+    glGenTextures(1, &r->lut_tex);
+    glBindTexture(GL_TEXTURE_2D, r->lut_tex);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RG16F, LUT_SIZE, LUT_SIZE);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, LUT_SIZE, LUT_SIZE, GL_RG, GL_FLOAT, t);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    free(t);
+    return rs_gl_check("render: specular table", err);
+}
+
+// Mean luminance of the irradiance (SH + the dominant light) over normals of the front half-space, by a
+// fixed spiral of directions: what the face mostly shows.
+static float front_irradiance(const rs_env *env)
+{
+    const int n = 256;
+    double sum = 0.0;
+    for (int i = 0; i < n; i++) {
+        float z = ((float)i + 0.5f) / (float)n;  // forward component, uniform over the hemisphere
+        float s = sqrtf(1.0f - z * z), phi = 2.39996323f * (float)i;
+        float d[3] = {s * cosf(phi), s * sinf(phi), z}, e[3];
+        rs_env_sh_irradiance(env, d, e);
+        float nl = RS_MAX(d[0] * env->light_dir[0] + d[1] * env->light_dir[1] + d[2] * env->light_dir[2], 0.0f);
+        for (int c = 0; c < 3; c++) e[c] += env->light_color[c] * nl;
+        sum += LUM(e);
+    }
+    return (float)(sum / n);
+}
+
+rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
+{
+    if (r->env_tex) glDeleteTextures(1, &r->env_tex);
+    r->env_tex = 0;
+    memset(&r->env, 0, sizeof r->env);
+    if (!env) return RS_OK;
+    rs_result res = make_lut(r, err);
+    if (res != RS_OK) return res;
+    if (env->level_count < 1 || env->level_count > RS_ENV_MAX_LEVELS)
+        return rs_fail(err, RS_ERR_ARG, "render: environment %s: %d levels", env->name, env->level_count);
+    int w = env->levels[0].width, h = env->levels[0].height;
+    if (w > r->caps.max_texture_size || h > r->caps.max_texture_size)
+        return rs_fail(err, RS_ERR_GL, "render: environment %s: %dx%d exceeds the GPU's %d", env->name, w, h,
+                       r->caps.max_texture_size);
+    glGenTextures(1, &r->env_tex);
+    glBindTexture(GL_TEXTURE_2D, r->env_tex);
+    glTexStorage2D(GL_TEXTURE_2D, env->level_count, GL_RGB9_E5, w, h);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    for (int k = 0; k < env->level_count; k++)
+        glTexSubImage2D(GL_TEXTURE_2D, k, 0, 0, env->levels[k].width, env->levels[k].height, GL_RGB,
+                        GL_UNSIGNED_INT_5_9_9_9_REV, env->levels[k].rgb9e5);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);  // longitude wraps
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, env->level_count - 1);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    res = rs_gl_check("render: environment upload", err);
+    if (res != RS_OK) {
+        glDeleteTextures(1, &r->env_tex);
+        r->env_tex = 0;
+        return res;
+    }
+    rs_render_env *e = &r->env;
+    e->on = true;
+    float front = front_irradiance(env);
+    e->scale = front > 1e-6f ? ENV_TARGET_FRONT / front : 1.0f;
+    for (int k = 0; k < 9; k++)
+        for (int c = 0; c < 3; c++) e->sh[k][c] = env->sh[k][c] * e->scale;
+    for (int c = 0; c < 3; c++) {
+        e->light_dir[c] = env->light_dir[c];
+        e->light_color[c] = env->light_color[c] * e->scale;
+    }
+    e->light_angle = env->light_angle;
+    e->levels = env->level_count;
+    for (int k = 0; k < env->level_count; k++) e->level_m[k] = env->level_m[k];
+    for (int k = env->level_count; k < RS_ENV_MAX_LEVELS; k++) e->level_m[k] = 2.0f;
+    return RS_OK;
+}
+
+bool rs_render_has_env(const rs_renderer *r) { return r->env.on; }
+
+void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog)
+{
+    bool on = f->env_on;
+    glUniform1f(rs_uloc(prog, "u_env_on"), on ? 1.0f : 0.0f);
+    rs_render_bind_texture(RS_UNIT_ENV, on ? r->env_tex : 0);
+    rs_render_bind_texture(RS_UNIT_SPEC_LUT, on ? r->lut_tex : 0);
+    if (!on) return;
+    float e = RS_MAX(f->view.env_intensity, 0.0f);
+    float sh[9][3];
+    for (int k = 0; k < 9; k++)
+        for (int c = 0; c < 3; c++) sh[k][c] = r->env.sh[k][c] * e;
+    glUniformMatrix3fv(rs_uloc(prog, "u_env_from_view"), 1, GL_FALSE, (const float *)f->env_from_view);
+    glUniform3fv(rs_uloc(prog, "u_env_sh"), 9, &sh[0][0]);
+    glUniform1fv(rs_uloc(prog, "u_env_m"), RS_ENV_MAX_LEVELS, r->env.level_m);
+    glUniform1i(rs_uloc(prog, "u_env_levels"), r->env.levels);
+    glUniform1f(rs_uloc(prog, "u_env_scale"), r->env.scale * e);
+}
+
+void rs_render_env_release(rs_renderer *r)
+{
+    GLuint t[2] = {r->env_tex, r->lut_tex};
+    glDeleteTextures(2, t);
+    r->env_tex = r->lut_tex = 0;
+    r->env.on = false;
+}
