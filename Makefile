@@ -42,7 +42,10 @@ LIB_LIBS := $(shell pkg-config --libs $(LIB_PKGS) 2>/dev/null) -lm
 LIBS := $(BUILD)/librouge.a $(PKG_LIBS) -lm
 # Tests also link the app's parts (UI, viewer, CLI) through libapp.a; the converter's tests libpack.
 TEST_LIBS := $(BUILD)/libapp.a $(LIBS)
-PACK_TESTS := test_pack test_ply
+PACK_TESTS := test_pack test_ply test_import
+# The converter's import (tools/pack/import_assimp.c, image_load.c): assimp, and stb_image's header.
+PACK_CFLAGS := $(shell pkg-config --cflags assimp stb 2>/dev/null)
+PACK_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
 
 VERSION  := 0.1.0
 SOMAJOR  := 0
@@ -67,7 +70,7 @@ $(BUILD)/obj/app/%.o: app/%.c
 
 $(BUILD)/obj/tools/%.o: tools/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PKG_CFLAGS) -Iinclude -Isrc -Itools -c $< -o $@
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) $(PACK_CFLAGS) -Iinclude -Isrc -Itools -c $< -o $@
 
 $(BUILD)/obj/tests/%.o: tests/%.c
 	@mkdir -p $(dir $@)
@@ -113,7 +116,7 @@ $(BUILD)/rouge: $(APP_OBJ) $(BUILD)/librouge.a
 
 # Only the converter links the converter library.
 $(BUILD)/rouge-pack: $(BUILD)/obj/tools/rouge_pack.o $(BUILD)/libpack.a $(BUILD)/librouge.a
-	$(CC) $(CFLAGS) $< $(BUILD)/libpack.a $(LIBS) $(LDFLAGS) -o $@
+	$(CC) $(CFLAGS) $< $(BUILD)/libpack.a $(PACK_LIBS) $(LIBS) $(LDFLAGS) -o $@
 
 # rouge-env (tools-time only) reads OpenEXR through the C++ library (tools/env/exr_read.cpp: OpenEXR 3.1's
 # C core cannot decode DWA, which blender-data's HDRIs use), so it links with the C++ compiler.
@@ -131,7 +134,7 @@ TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(sort $(wildcard tests/supp
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a) $(TEST_LIBS) $(LDFLAGS) -o $@
+	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a $(PACK_LIBS)) $(TEST_LIBS) $(LDFLAGS) -o $@
 
 run: deps
 	@$(MAKE) --no-print-directory all

@@ -1,9 +1,10 @@
-// rouge_pack.c — rouge-pack: converts a PLY scan (point cloud or textured mesh) into an .rsf splat file,
+// rouge_pack.c — rouge-pack: converts a scan (PLY, OBJ, glTF, FBX, ...: point cloud or textured mesh) into an .rsf splat file,
 // and prints what an .rsf holds (see tools/pack/pack.h for the steps, docs/rsf.md for the format).
 //
 // Exit status: 0 done, 1 the conversion or a file failed, 2 usage. Errors are one "rouge-pack: ..." line
 // on stderr; a progress bar goes to stderr only when it is a terminal; the summary goes to stdout.
 #define _POSIX_C_SOURCE 200809L
+#include "pack/import.h"
 #include "pack/pack.h"
 
 #include <errno.h>
@@ -16,17 +17,22 @@
 #include <unistd.h>
 
 static const char usage[] =
-    "usage: rouge-pack INPUT.ply -o OUT.rsf [options]\n"
+    "usage: rouge-pack INPUT -o OUT.rsf [options]\n"
     "       rouge-pack --info FILE.rsf [--preview PNG]\n"
     "\n"
-    "Converts a PLY scan into rouge's compact splat file (.rsf, 16 bytes per splat): normals (estimated\n"
-    "by k-nearest-neighbour PCA when the PLY has none), a radius per splat from the local spacing, LOD\n"
+    "Converts a scan into rouge's compact splat file (.rsf, 16 bytes per splat): normals (estimated\n"
+    "by k-nearest-neighbour PCA when the input has none), a radius per splat from the local spacing, LOD\n"
     "order (every prefix in the LOD table is an even subsample), and face regions for the skin BRDF.\n"
     "\n"
-    "Input: ASCII or binary PLY; a point cloud is used as it is, a mesh (faces) is sampled area-uniformly.\n"
+    "Input: PLY (ASCII or binary, rouge's own reader), or through assimp OBJ (+ MTL), glTF / GLB, FBX,\n"
+    "STL, DAE, 3DS, OFF and the other formats assimp reads. A point cloud is used as it is, a mesh is\n"
+    "sampled area-uniformly. Colour: --texture, else each material's base-colour texture (MTL map_Kd,\n"
+    "glTF baseColorTexture, embedded GLB images; PNG or JPEG; several materials sample each face from\n"
+    "its own page), else the vertex colours.\n"
     "  --points N          mesh: number of splats to sample (default 600000); cloud: decimate to N\n"
     "                      (a Poisson-disk-like subset); default keeps every point\n"
-    "  --texture PNG       sRGB colour map, sampled bilinearly at (s, 1 - t): t = 0 is the bottom row\n"
+    "  --texture IMAGE     sRGB colour map (PNG or JPEG) for every face, sampled bilinearly at (s, 1 - t)\n"
+    "                      with the coordinates as the file stores them: t = 0 is the bottom row\n"
     "  --normal-map PNG    tangent-space normal map (OpenGL convention, +G along +t); mesh only\n"
     "  --specular-map PNG  specular-intensity map: measured per region and printed in the summary only;\n"
     "                      the .rsf keeps per-region m and rho_s (Weyrich et al. means), not per splat\n"
@@ -178,6 +184,8 @@ typedef struct options {
     const char *maps[4];  // texture, normal, specular, region
     rs_pack_desc desc;
     bool quiet;
+    char format[64];          // what the input was read as ("PLY", "glTF 2.0", ...)
+    uint32_t pages_textured;  // materials whose own texture coloured the splats
 } options;
 
 static const char *const map_flag[4] = {"--texture", "--normal-map", "--specular-map", "--region-map"};
@@ -189,10 +197,10 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
     long long in_size = file_size(o->input), out_size = file_size(o->output);
     printf("rouge-pack: %s -> %s\n", o->input, o->output);
     if (rep->sampled_mesh)
-        printf("  input         mesh, %u vertices, %u triangles (%u outside the largest component, skipped)\n",
-               rep->input_vertices, rep->input_triangles, rep->triangles_dropped);
+        printf("  input         %s mesh, %u vertices, %u triangles (%u outside the largest component, skipped)\n",
+               o->format, rep->input_vertices, rep->input_triangles, rep->triangles_dropped);
     else
-        printf("  input         point cloud, %u points%s\n", rep->input_vertices,
+        printf("  input         %s point cloud, %u points%s\n", o->format, rep->input_vertices,
                rep->duplicates_dropped ? " (duplicates dropped)" : "");
     if (rep->duplicates_dropped) printf("  duplicates    %u points at the same position dropped\n", rep->duplicates_dropped);
     printf("  splats        %u%s\n", rep->splats, rep->sampled_mesh ? " (area-uniform samples)" : "");
@@ -201,8 +209,12 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
                rep->normals_replaced);
     else
         printf("  normals       %s\n", rep->normals_estimated ? "estimated (16-NN PCA, MST orientation)" : "from the input");
-    printf("  colour        %s\n", rep->colour_default ? "none in the input: light warm grey (sRGB 200 178 160)"
-                                                        : (o->maps[0] ? "from the texture" : "from the input"));
+    if (o->pages_textured)
+        printf("  colour        from the %s (%u page%s)\n", o->pages_textured > 1 ? "materials' textures" : "material's texture",
+               o->pages_textured, o->pages_textured > 1 ? "s" : "");
+    else
+        printf("  colour        %s\n", rep->colour_default ? "none in the input: light warm grey (sRGB 200 178 160)"
+                                                            : (o->maps[0] ? "from the texture" : "from the input"));
     if (o->texture_hint[0])
         printf("  note          the PLY names the texture '%s'; pass --texture to colour from it\n", o->texture_hint);
     printf("  size          %lld bytes = %.2f bytes/splat (input PLY: %lld bytes = %.2f bytes/%s)\n", out_size,
@@ -251,25 +263,45 @@ static int convert(options *o)
     if (access(dir, W_OK) != 0) return fail(1, "%s: cannot write: %s", o->output, strerror(errno));
 
     double t0 = rs_time_now();
-    rs_ply_mesh *mesh = NULL;
-    if (rs_ply_load(o->input, &mesh, &err) != RS_OK) return fail(1, "%s", err.msg);
+    rs_import_scene *scene = NULL;
+    if (rs_import_load(o->input, &scene, &err) != RS_OK) return fail(1, "%s", err.msg);
+    rs_ply_mesh *mesh = scene->mesh;
+    snprintf(o->format, sizeof o->format, "%s", scene->format_name);
     // Shown even with -q: the file was accepted on a reading the format does not spell out.
     if (mesh->warnings[0]) {
         char w[sizeof mesh->warnings * 4];
         rs_text_sanitize(w, sizeof w, mesh->warnings, strlen(mesh->warnings));
         fprintf(stderr, "rouge-pack: warning: %s: %s\n", o->input, w);
     }
+    // Maps given here are not the file's own: they are sampled with the coordinates as the file stores
+    // them, t = 0 the bottom row (the PLY and OBJ convention, and three.js's for the bundled GLB), so
+    // undo the flip assimp applies to glTF's top-left origin.
+    bool external_maps = o->maps[0] || o->maps[1] || o->maps[2] || o->maps[3];
+    if (external_maps && scene->v_flipped && mesh->uv)
+        for (uint32_t i = 0; i < mesh->vertex_count; i++) mesh->uv[i][1] = 1.0f - mesh->uv[i][1];
     rs_image img[4] = {{0}};
     const rs_image **slot[4] = {&o->desc.texture, &o->desc.normal_map, &o->desc.specular_map, &o->desc.region_map};
     for (int k = 0; k < 4; k++) {
         if (!o->maps[k]) continue;
-        if (rs_image_read_png(o->maps[k], &img[k], &err) != RS_OK) {
+        rs_result r = k == 0 ? rs_image_load_any(o->maps[k], &img[k], &err) : rs_image_read_png(o->maps[k], &img[k], &err);
+        if (r != RS_OK) {
             for (int j = 0; j < k; j++) rs_image_free(&img[j]);
-            rs_ply_destroy(mesh);
+            rs_import_destroy(scene);
             return fail(1, "%s: %s", map_flag[k], err.msg);
         }
         *slot[k] = &img[k];
     }
+    // The materials' own colour textures, unless --texture replaces them.
+    rs_image *pages = NULL;
+    if (!o->maps[0] && rs_import_load_pages(scene, &pages, &err) != RS_OK) {
+        for (int k = 0; k < 4; k++) rs_image_free(&img[k]);
+        rs_import_destroy(scene);
+        return fail(1, "%s", err.msg);
+    }
+    uint32_t page_count = pages ? scene->page_count : 0;
+    for (uint32_t i = 0; i < page_count; i++) o->pages_textured += pages[i].pixels != NULL;
+    o->desc.pages = pages;
+    o->desc.page_count = page_count;
     double load_s = rs_time_now() - t0;
 
     char notes[512];
@@ -299,7 +331,9 @@ static int convert(options *o)
     }
     if (bar.on) fputs("\r\033[K", stderr);
     for (int k = 0; k < 4; k++) rs_image_free(&img[k]);
-    rs_ply_destroy(mesh);
+    rs_import_free_pages(pages, page_count);
+    o->desc.pages = NULL;
+    rs_import_destroy(scene);
     if (r != RS_OK) return fail(1, "%s: %s", o->input, err.msg);
 
     // The preview is drawn before anything is written, so a failure leaves no files behind.
@@ -390,7 +424,7 @@ int main(int argc, char **argv)
         if (o.input || o.output) return fail(2, "--info takes only an .rsf file (and --preview)");
         return info(info_path, o.preview);
     }
-    if (!o.input) return fail(2, "no input PLY (see --help)");
+    if (!o.input) return fail(2, "no input scan (see --help)");
     rs_pack_axis up = o.desc.up ? o.desc.up : RS_PACK_AXIS_POS_Y, fwd = o.desc.forward ? o.desc.forward : RS_PACK_AXIS_POS_Z;
     if ((up - 1) / 2 == (fwd - 1) / 2) return fail(2, "--up and --forward must be different axes");
     if (!o.output) return fail(2, "no output: give -o OUT.rsf");

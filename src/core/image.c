@@ -155,24 +155,18 @@ static bool decode(png_reader *r)
     return true;
 }
 
-rs_result rs_image_read_png(const char *path, rs_image *out, rs_error *err)
+rs_result rs_image_read_png_memory(const void *data, size_t len, const char *name, rs_image *out, rs_error *err)
 {
-    void *data;
-    size_t len;
-    rs_result res = rs_file_read_all(path, PNG_MAX_FILE_BYTES, &data, &len, err);
-    if (res != RS_OK) return res;
-    if (len < 8 || png_sig_cmp(data, 0, 8) != 0) {
-        free(data);
-        return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG file (bad signature at byte 0)", path);
-    }
-
+    if (len < 8 || png_sig_cmp(data, 0, 8) != 0)
+        return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG file (bad signature at byte 0)", name);
+    rs_result res = RS_OK;
     png_reader r = { .data = data, .len = len, .code = RS_ERR_FORMAT };
     r.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &r, png_on_error, png_on_warning);
     r.info = r.png ? png_create_info_struct(r.png) : NULL;
     if (!r.png || !r.info) {
-        res = rs_fail(err, RS_ERR_NOMEM, "%s: out of memory for the PNG decoder", path);
+        res = rs_fail(err, RS_ERR_NOMEM, "%s: out of memory for the PNG decoder", name);
     } else if (!decode(&r)) {
-        res = rs_fail(err, r.code, "%s: %s", path, r.msg);
+        res = rs_fail(err, r.code, "%s: %s", name, r.msg);
     } else {
         *out = (rs_image){ .width = r.width, .height = r.height, .channels = r.channels, .pixels = r.pixels };
         r.pixels = NULL;
@@ -180,6 +174,16 @@ rs_result rs_image_read_png(const char *path, rs_image *out, rs_error *err)
     png_destroy_read_struct(&r.png, &r.info, NULL);
     free(r.rows);
     free(r.pixels);
+    return res;
+}
+
+rs_result rs_image_read_png(const char *path, rs_image *out, rs_error *err)
+{
+    void *data;
+    size_t len;
+    rs_result res = rs_file_read_all(path, PNG_MAX_FILE_BYTES, &data, &len, err);
+    if (res != RS_OK) return res;
+    res = rs_image_read_png_memory(data, len, path, out, err);
     free(data);
     return res;
 }

@@ -40,6 +40,8 @@ rs_result rs_image_create(int width, int height, int channels, rs_image *out, rs
 void rs_image_free(rs_image *img);
 
 rs_result rs_image_read_png(const char *path, rs_image *out, rs_error *err);
+// The same from a PNG file's bytes (e.g. embedded in a GLB); `name` prefixes the messages.
+rs_result rs_image_read_png_memory(const void *data, size_t len, const char *name, rs_image *out, rs_error *err);
 rs_result rs_image_write_png(const char *path, const rs_image *img, rs_error *err);
 
 // a and b must have the same size; alpha is ignored. `threshold` feeds frac_over.

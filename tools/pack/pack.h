@@ -130,6 +130,10 @@ typedef struct rs_pack_sample_desc {
     uint64_t seed;               // 0 = RS_PACK_DEFAULT_SEED
     bool all_components;         // false: keep only the largest connected component (by area)
     const rs_image *texture;     // sRGB colour, texel (s W, (1 - t) H) from the top row, bilinear
+    // Per-material colour pages when `texture` is NULL: triangle t samples pages[m->tri_page[t]] (page 0
+    // when the mesh has no tri_page); a page without pixels falls back to vertex colours.
+    const rs_image *pages;
+    uint32_t page_count;
     const rs_image *normal_map;  // tangent space, OpenGL convention (+G along +t)
     const rs_image *specular_map;
     const rs_image *region_map;  // UV-space region codes (see rs_pack_region_from_rgb)
@@ -206,6 +210,8 @@ typedef struct rs_pack_desc {
     uint64_t seed;                // 0 = RS_PACK_DEFAULT_SEED
     bool all_components;          // mesh: keep every component (default: the largest, i.e. the skin)
     const rs_image *texture, *normal_map, *specular_map, *region_map;  // need texture coordinates
+    const rs_image *pages;        // mesh: per-material colour pages when texture is NULL (see sampling)
+    uint32_t page_count;
     float mm_per_unit;            // 0 = estimate from the head height (RS_PACK_ASSUMED_HEAD_MM)
     uint32_t min_lod;             // smallest LOD prefix (0 = RS_PACK_DEFAULT_MIN_LOD)
     rs_pack_axis up, forward;     // 0 = +Y up, +Z forward

@@ -222,7 +222,8 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     step_begin(&c, RS_PACK_STEP_SAMPLE);
     if (in->tri && in->tri_count > 0) {
         rs_pack_sample_desc sd = {.points = d->points, .seed = d->seed, .all_components = d->all_components,
-                                  .texture = d->texture, .normal_map = d->normal_map,
+                                  .texture = d->texture, .pages = d->pages, .page_count = d->page_count,
+                                  .normal_map = d->normal_map,
                                   .specular_map = d->specular_map, .region_map = d->region_map};
         r = rs_pack_sample_mesh(in, &sd, &p, &rep->triangles_dropped, err);
         rep->sampled_mesh = true;

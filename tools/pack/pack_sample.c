@@ -95,6 +95,51 @@ static uint32_t uf_find(uint32_t *parent, uint32_t x)
     return x;
 }
 
+static void uf_union(uint32_t *parent, uint32_t x, uint32_t y)
+{
+    uint32_t a = uf_find(parent, x), b = uf_find(parent, y);
+    if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+}
+
+typedef struct vkey {
+    float p[3];
+    uint32_t id;
+} vkey;
+
+static int cmp_vkey(const void *a, const void *b)
+{
+    const vkey *x = a, *y = b;
+    for (int k = 0; k < 3; k++)
+        if (x->p[k] != y->p[k]) return x->p[k] < y->p[k] ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+// A multi-material model splits its surface into one vertex set per material: vertices of different
+// pages at the same position are joined, so a scan cut into texture pages is still one component.
+static rs_result join_pages(const rs_ply_mesh *m, uint32_t *parent, rs_error *err)
+{
+    uint16_t *vpage = rs_alloc_array(m->vertex_count, sizeof *vpage);
+    vkey *k = rs_alloc_array(m->vertex_count, sizeof *k);
+    if (!vpage || !k) {
+        free(vpage);
+        free(k);
+        return rs_fail(err, RS_ERR_NOMEM, "mesh: out of memory for %u vertices", m->vertex_count);
+    }
+    for (uint32_t t = 0; t < m->tri_count; t++)
+        for (int c = 0; c < 3; c++) vpage[m->tri[t][c]] = m->tri_page[t];
+    for (uint32_t v = 0; v < m->vertex_count; v++) {
+        memcpy(k[v].p, m->pos[v], sizeof k[v].p);
+        k[v].id = v;
+    }
+    qsort(k, m->vertex_count, sizeof *k, cmp_vkey);
+    for (uint32_t i = 1; i < m->vertex_count; i++)
+        if (!memcmp(k[i].p, k[i - 1].p, sizeof k[i].p) && vpage[k[i].id] != vpage[k[i - 1].id])
+            uf_union(parent, k[i].id, k[i - 1].id);
+    free(vpage);
+    free(k);
+    return RS_OK;
+}
+
 // Keeps the triangles of the largest component (by area): triangles sharing a vertex index are
 // connected. The data's meshes split vertices along UV seams, so components are the UV islands and the
 // largest is the skin (leeperrysmith README, "Non-skin parts of the mesh").
@@ -109,10 +154,15 @@ static rs_result largest_component(const rs_ply_mesh *m, const double *area, uin
     }
     for (uint32_t v = 0; v < m->vertex_count; v++) parent[v] = v;
     for (uint32_t t = 0; t < m->tri_count; t++)
-        for (int e = 1; e < 3; e++) {
-            uint32_t a = uf_find(parent, m->tri[t][0]), b = uf_find(parent, m->tri[t][e]);
-            if (a != b) parent[a < b ? b : a] = a < b ? a : b;
+        for (int e = 1; e < 3; e++) uf_union(parent, m->tri[t][0], m->tri[t][e]);
+    if (m->tri_page) {
+        rs_result r = join_pages(m, parent, err);
+        if (r != RS_OK) {
+            free(parent);
+            free(comp);
+            return r;
         }
+    }
     for (uint32_t t = 0; t < m->tri_count; t++) comp[uf_find(parent, m->tri[t][0])] += area[t];
     uint32_t best = 0;
     for (uint32_t v = 1; v < m->vertex_count; v++)
@@ -173,6 +223,8 @@ rs_result rs_pack_sample_mesh(const rs_ply_mesh *m, const rs_pack_sample_desc *d
     if (m->tri_count == 0 || !m->tri) return rs_fail(err, RS_ERR_ARG, "mesh: the PLY has no faces to sample");
     if ((d->texture || d->normal_map || d->specular_map || d->region_map) && !m->uv)
         return rs_fail(err, RS_ERR_ARG, "mesh: texture maps need texture coordinates (s t, u v or texture_u texture_v)");
+    // Material pages without texture coordinates cannot be sampled: vertex colours (or none) instead.
+    bool paged = !d->texture && m->uv && d->pages && d->page_count > 0;
     if (n > RS_SPLAT_MAX_COUNT) return rs_fail(err, RS_ERR_LIMIT, "mesh: %u points asked, at most %u", n, RS_SPLAT_MAX_COUNT);
 
     rs_pack_points p = {.count = n};
@@ -183,11 +235,11 @@ rs_result rs_pack_sample_mesh(const rs_ply_mesh *m, const rs_pack_sample_desc *d
     p.pos = rs_alloc_array(n, sizeof *p.pos);
     p.normal = rs_alloc_array(n, sizeof *p.normal);
     p.region = rs_alloc_array(n, 1);
-    p.rgb = d->texture || m->rgb ? rs_alloc_array(n, sizeof *p.rgb) : NULL;
+    p.rgb = d->texture || paged || m->rgb ? rs_alloc_array(n, sizeof *p.rgb) : NULL;
     p.specular = d->specular_map ? rs_alloc_array(n, sizeof *p.specular) : NULL;
     rs_result res = RS_OK;
     if (!area || !keep || !vn || (d->normal_map && !tan) || !p.pos || !p.normal || !p.region ||
-        ((d->texture || m->rgb) && !p.rgb) || (d->specular_map && !p.specular)) {
+        ((d->texture || paged || m->rgb) && !p.rgb) || (d->specular_map && !p.specular)) {
         res = rs_fail(err, RS_ERR_NOMEM, "mesh: out of memory sampling %u points", n);
         goto out;
     }
@@ -269,13 +321,20 @@ rs_result rs_pack_sample_mesh(const rs_ply_mesh *m, const rs_pack_sample_desc *d
             }
         }
         memcpy(p.normal[s], nrm, sizeof nrm);
-        if (d->texture) {
+        const rs_image *colour = d->texture;
+        if (paged) {
+            uint32_t pg = m->tri_page ? m->tri_page[lo] : 0;
+            colour = pg < d->page_count && d->pages[pg].pixels ? &d->pages[pg] : NULL;
+        }
+        if (colour) {
             float c[3];
-            sample_bilinear(d->texture, uv[0], uv[1], c);
+            sample_bilinear(colour, uv[0], uv[1], c);
             for (int a = 0; a < 3; a++) p.rgb[s][a] = (uint8_t)lrintf(RS_CLAMP(c[a], 0.0f, 255.0f));
         } else if (m->rgb) {
             for (int a = 0; a < 3; a++)
                 p.rgb[s][a] = (uint8_t)lrintf(w[0] * m->rgb[i[0]][a] + w[1] * m->rgb[i[1]][a] + w[2] * m->rgb[i[2]][a]);
+        } else if (p.rgb) {
+            p.rgb[s][0] = RS_PACK_DEFAULT_RGB_R, p.rgb[s][1] = RS_PACK_DEFAULT_RGB_G, p.rgb[s][2] = RS_PACK_DEFAULT_RGB_B;
         }
         if (d->specular_map) {
             float c[3];

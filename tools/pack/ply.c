@@ -859,6 +859,7 @@ void rs_ply_destroy(rs_ply_mesh *m)
     free(m->uv);
     free(m->region);
     free(m->tri);
+    free(m->tri_page);
     free(m->comments);
     free(m->texture_file);
     free(m);

@@ -31,6 +31,8 @@ typedef struct rs_ply_mesh {
     uint8_t *region;      // NULL when the file has no per-vertex `region` property
     uint32_t tri_count;
     uint32_t (*tri)[3];   // NULL when the file has no faces; indices validated < vertex_count
+    uint16_t *tri_page;   // texture page (material) per triangle, or NULL (all page 0): set by import.h
+                          // for multi-material models, never by the PLY reader
     char *comments;       // header comments joined by '\n' (carries the CC-BY attribution), never NULL
     char *texture_file;   // from "comment TextureFile NAME" (MeshLab convention), or NULL
     char warnings[512];   // what was accepted though not by the letter of the format ("; "-joined), or ""

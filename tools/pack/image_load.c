@@ -1,0 +1,116 @@
+// image_load.c — texture images for rouge-pack: PNG or JPEG by content (see import.h).
+//
+// One decoder per format: PNG goes through src/core/image.c (libpng, already used to write PNGs, with its
+// own bomb check), JPEG through stb_image (Debian's libstb-dev: one public-domain header, no state, and
+// it decodes baseline and progressive JPEG from memory). stb is compiled here with only its JPEG decoder,
+// so no second PNG decoder is linked in.
+#include "pack/import.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define STBI_ONLY_JPEG
+#define STBI_NO_STDIO
+#define STBI_NO_LINEAR
+#define STBI_NO_HDR
+#define STBI_MAX_DIMENSIONS RS_IMAGE_MAX_DIM
+#define STB_IMAGE_IMPLEMENTATION
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-parameter"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wtype-limits"
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wdouble-promotion"
+#include <stb_image.h>
+#pragma GCC diagnostic pop
+
+// A JPEG codes every 8x8 block of every component with at least one bit (a 1-bit DC difference code;
+// progressive end-of-band runs skip only AC coefficients), so n bytes hold at most 8 n blocks: a header
+// claiming more is a decompression bomb, refused before stb allocates the image.
+#define JPEG_MIN_BITS_PER_BLOCK 1u
+
+static rs_result decode_jpeg(const uint8_t *data, size_t len, const char *name, rs_image *out, rs_error *err)
+{
+    if (len > (size_t)INT32_MAX) return rs_fail(err, RS_ERR_LIMIT, "%s: JPEG of %zu bytes is too large", name, len);
+    int w = 0, h = 0, comp = 0;
+    if (!stbi_info_from_memory(data, (int)len, &w, &h, &comp))
+        return rs_fail(err, RS_ERR_FORMAT, "%s: not a readable JPEG file (%s)", name, stbi_failure_reason());
+    if (w < 1 || h < 1 || w > RS_IMAGE_MAX_DIM || h > RS_IMAGE_MAX_DIM)
+        return rs_fail(err, RS_ERR_LIMIT, "%s: image is %dx%d, larger than the %d allowed", name, w, h, RS_IMAGE_MAX_DIM);
+    uint64_t px = (uint64_t)w * (uint64_t)h;
+    if (px > RS_IMPORT_MAX_TEXTURE_PIXELS)
+        return rs_fail(err, RS_ERR_LIMIT, "%s: image is %dx%d = %.1f Mpx, more than the %.0f Mpx allowed", name, w, h,
+                       px / 1e6, RS_IMPORT_MAX_TEXTURE_PIXELS / 1e6);
+    uint64_t blocks = ((uint64_t)(w + 7) / 8) * ((uint64_t)(h + 7) / 8);
+    if (blocks > (uint64_t)len * 8 / JPEG_MIN_BITS_PER_BLOCK)
+        return rs_fail(err, RS_ERR_FORMAT, "%s: header claims %dx%d pixels but the %zu-byte file cannot hold that much data",
+                       name, w, h, len);
+    int cw, ch, cc;
+    uint8_t *px8 = stbi_load_from_memory(data, (int)len, &cw, &ch, &cc, 3);
+    if (!px8) {
+        const char *why = stbi_failure_reason();
+        if (why && !strcmp(why, "outofmem")) return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory decoding %dx%d", name, w, h);
+        return rs_fail(err, RS_ERR_FORMAT, "%s: bad JPEG data (%s)", name, why ? why : "?");
+    }
+    if (cw != w || ch != h) {
+        stbi_image_free(px8);
+        return rs_fail(err, RS_ERR_FORMAT, "%s: decoded size %dx%d differs from the header's %dx%d", name, cw, ch, w, h);
+    }
+    // Handed over as an rs_image, which rs_image_free releases with free(): stb allocates with malloc.
+    *out = (rs_image){.width = w, .height = h, .channels = 3, .pixels = px8};
+    return RS_OK;
+}
+
+// stb decodes a JPEG cut short as if the rest were zeros (a grey band): refuse files without the
+// end-of-image marker, allowing trailing bytes after it (some cameras append data).
+static bool jpeg_has_end(const uint8_t *d, size_t len)
+{
+    size_t from = len > 65536 ? len - 65536 : 2;
+    for (size_t i = len - 1; i > from; i--)
+        if (d[i - 1] == 0xff && d[i] == 0xd9) return true;
+    return false;
+}
+
+rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs_image *out, rs_error *err)
+{
+    const uint8_t *d = data;
+    static const uint8_t png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    if (len >= 8 && !memcmp(d, png_sig, 8)) {
+        // Pixel cap first (IHDR is the first chunk: width and height at bytes 16..23), then libpng's own
+        // checks (sides, and what the compressed bytes can hold).
+        if (len >= 24) {
+            uint64_t w = (uint64_t)d[16] << 24 | (uint64_t)d[17] << 16 | (uint64_t)d[18] << 8 | d[19];
+            uint64_t h = (uint64_t)d[20] << 24 | (uint64_t)d[21] << 16 | (uint64_t)d[22] << 8 | d[23];
+            if (w <= RS_IMAGE_MAX_DIM && h <= RS_IMAGE_MAX_DIM && w * h > RS_IMPORT_MAX_TEXTURE_PIXELS)
+                return rs_fail(err, RS_ERR_LIMIT, "%s: image is %llux%llu = %.1f Mpx, more than the %.0f Mpx allowed", name,
+                               (unsigned long long)w, (unsigned long long)h, (double)(w * h) / 1e6,
+                               RS_IMPORT_MAX_TEXTURE_PIXELS / 1e6);
+        }
+        return rs_image_read_png_memory(data, len, name, out, err);
+    }
+    if (len >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff) {
+        if (!jpeg_has_end(d, len))
+            return rs_fail(err, RS_ERR_FORMAT, "%s: JPEG is truncated (no end-of-image marker in its %zu bytes)", name, len);
+        return decode_jpeg(d, len, name, out, err);
+    }
+    if (len == 0) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file (empty)", name);
+    char hex[16] = "";
+    for (size_t i = 0; i < RS_MIN(len, (size_t)4); i++) snprintf(hex + 3 * i, sizeof hex - 3 * i, "%02x ", d[i]);
+    hex[strlen(hex) - 1] = 0;
+    return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file (starts %s)", name, hex);
+}
+
+rs_result rs_image_load_any(const char *path, rs_image *out, rs_error *err)
+{
+    void *data;
+    size_t len;
+    rs_result r = rs_file_read_all(path, RS_IMPORT_MAX_FILE, &data, &len, err);
+    if (r != RS_OK) return r;
+    r = rs_image_decode_any(data, len, path, out, err);
+    free(data);
+    return r;
+}

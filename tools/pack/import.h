@@ -1,0 +1,95 @@
+// import.h — the scan formats people have, read into the converter's mesh: PLY through rouge's own reader
+// (ply.h), everything else (OBJ + MTL, glTF / GLB, FBX, STL, DAE, 3DS, OFF, ...) through assimp, plus the
+// texture images their materials name (PNG through libpng, JPEG through stb_image).
+//
+// Does: route a file by its content (a "ply" magic line) or its extension; flatten an assimp scene into
+// one triangle mesh (node transforms applied, polygons triangulated, vertices that share position, UV and
+// material welded so the index graph is the surface), one texture page per material, per-triangle page
+// ids; read the unit the format declares (glTF: metres; FBX: UnitScaleFactor; COLLADA: <unit>, applied
+// by assimp); find each material's base-colour texture (glTF baseColorTexture, MTL map_Kd, also with
+// spaces in the file name, embedded GLB / FBX images) and decode it with size limits checked before the
+// pixels are allocated. Files are opened through our own I/O callbacks: regular files only, size-capped,
+// so an MTL naming a FIFO or /dev/zero cannot hang or exhaust the import.
+// Does not: sample, convert or write anything (pack.h), or keep animation, bones, cameras or lights.
+//
+//   rs_import_scene *s = NULL;
+//   if (rs_import_load("head.obj", &s, &err) != RS_OK) { puts(err.msg); return 1; }
+//   rs_image *pages = NULL;
+//   if (rs_import_load_pages(s, &pages, &err) == RS_OK) ... rs_pack_convert(s->mesh, &desc, ...);
+//   rs_import_free_pages(pages, s->page_count);
+//   rs_import_destroy(s);
+#ifndef RS_IMPORT_H
+#define RS_IMPORT_H
+
+#include "core/core.h"
+#include "core/image.h"
+#include "pack/ply.h"
+
+#define RS_IMPORT_MAX_FILE ((size_t)2 << 30)    // any one file (model, MTL, .bin, texture): 2 GiB
+#define RS_IMPORT_MAX_VERTICES (1u << 26)       // after triangulation, before welding
+#define RS_IMPORT_MAX_TRIANGLES (1u << 27)
+#define RS_IMPORT_MAX_PAGES 256                 // materials (texture pages)
+// Texture limits, checked from the image header before any pixel is allocated: a side of at most
+// RS_IMAGE_MAX_DIM and at most 64 Mpx (an 8K x 8K page, 192 MiB as RGB).
+#define RS_IMPORT_MAX_TEXTURE_PIXELS ((uint64_t)8192 * 8192)
+
+typedef enum rs_import_format {
+    RS_IMPORT_PLY,
+    RS_IMPORT_OBJ,
+    RS_IMPORT_GLTF,   // .gltf or .glb
+    RS_IMPORT_FBX,
+    RS_IMPORT_DAE,
+    RS_IMPORT_STL,
+    RS_IMPORT_OTHER,  // any other format assimp reads
+} rs_import_format;
+
+// One material: where its base-colour texture comes from (neither: the page has no texture).
+typedef struct rs_import_page {
+    char name[64];          // material name, for messages (sanitised when printed)
+    char *texture;          // the path as the file names it (relative to the model's folder), or NULL
+    const uint8_t *embedded;  // the image file's bytes when the model embeds it (GLB, FBX), or NULL
+    size_t embedded_len;
+} rs_import_page;
+
+typedef struct rs_import_scene {
+    rs_ply_mesh *mesh;          // the geometry; mesh->tri_page is set when there is more than one page
+    rs_import_format format;
+    char format_name[64];       // "glTF 2.0 (binary)", "Wavefront OBJ", ... for the summary
+    char path[4096];            // the model file, to resolve texture paths
+    // The unit the file declares, as millimetres per model unit (0 = the format has none, e.g. OBJ, STL),
+    // and where it came from ("glTF: metres by definition").
+    float declared_mm_per_unit;
+    char unit_source[96];
+    // glTF's texture origin is the top-left corner; assimp flips v so that every format's UVs follow the
+    // OpenGL convention (t = 0 is the bottom row). True when that flip was applied, so a texture given
+    // on the command line (not named by the file) can be sampled with the file's own coordinates.
+    bool v_flipped;
+    uint32_t page_count;
+    rs_import_page *pages;      // page_count entries (NULL when 0)
+    uint32_t points_dropped;    // point and line primitives of a mesh that also has triangles
+    void *priv;                 // assimp's scene (embedded images point into it)
+} rs_import_scene;
+
+// Reads any supported model (see above). Errors: one line naming the file; a file that neither the PLY
+// reader nor assimp can read says which formats are supported.
+rs_result rs_import_load(const char *path, rs_import_scene **out, rs_error *err);
+// Same, from memory (the fuzz harness): `hint` is the file extension ("obj", "glb"); materials can name
+// no external files here.
+rs_result rs_import_load_memory(const void *data, size_t len, const char *hint, rs_import_scene **out,
+                                rs_error *err);
+void rs_import_destroy(rs_import_scene *s);
+const char *rs_import_format_name(rs_import_format f);
+
+// Decodes every page's texture (embedded bytes, or the file named relative to the model's folder) into
+// *out (page_count images; a page without a texture stays zeroed). A texture that is missing or
+// unreadable is an error naming the material and the file.
+rs_result rs_import_load_pages(const rs_import_scene *s, rs_image **out, rs_error *err);
+void rs_import_free_pages(rs_image *pages, uint32_t count);
+
+// Texture images (image_load.c): PNG (libpng, src/core/image.c) or JPEG (stb_image), by content. The size
+// the header claims is checked (sides, RS_IMPORT_MAX_TEXTURE_PIXELS, and what the file's bytes can encode)
+// before pixels are allocated. `name` is used in messages.
+rs_result rs_image_load_any(const char *path, rs_image *out, rs_error *err);
+rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs_image *out, rs_error *err);
+
+#endif

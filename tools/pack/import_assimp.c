@@ -1,0 +1,693 @@
+// import_assimp.c — models through assimp (and PLY through ply.c) into one welded triangle mesh; see
+// import.h.
+//
+// Why assimp: one maintained library (Debian's libassimp-dev, C API) reads the forty-odd formats scans come
+// in, with their materials and node transforms. Why PLY stays ours: ply.c is faster on 600k-point clouds,
+// keeps the `region` property and the header comments (attribution), and has been fuzzed and
+// hardened; assimp's PLY reader drops point clouds' extra properties.
+#define _POSIX_C_SOURCE 200809L
+#include "pack/import.h"
+
+#include <assimp/cfileio.h>
+#include <assimp/cimport.h>
+#include <assimp/material.h>
+#include <assimp/metadata.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <strings.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+const char *rs_import_format_name(rs_import_format f)
+{
+    static const char *names[] = {"PLY", "Wavefront OBJ", "glTF 2.0", "FBX", "COLLADA", "STL", "model"};
+    return f <= RS_IMPORT_OTHER ? names[f] : "?";
+}
+
+// ---- file access for assimp: regular files only, size-capped, read whole into memory ----
+
+typedef struct io_ctx {
+    const char *mem_name;  // a file served from memory (rs_import_load_memory), or NULL
+    const uint8_t *mem;
+    size_t mem_len;
+    bool disk;             // other files may be read from disk
+    const char *main;      // the model itself: why opening it failed is the error to report
+    char failed[512];
+} io_ctx;
+
+typedef struct io_file {
+    const uint8_t *data;
+    uint8_t *owned;
+    size_t len, pos;
+} io_file;
+
+static size_t io_read(struct aiFile *f, char *buf, size_t size, size_t count)
+{
+    io_file *h = (io_file *)f->UserData;
+    if (size == 0) return 0;
+    size_t n = RS_MIN(count, (h->len - h->pos) / size);
+    memcpy(buf, h->data + h->pos, n * size);
+    h->pos += n * size;
+    return n;
+}
+
+static size_t io_write(struct aiFile *f, const char *buf, size_t size, size_t count)
+{
+    (void)f, (void)buf, (void)size, (void)count;
+    return 0;
+}
+
+static size_t io_tell(struct aiFile *f)
+{
+    return ((io_file *)f->UserData)->pos;
+}
+
+static size_t io_size(struct aiFile *f)
+{
+    return ((io_file *)f->UserData)->len;
+}
+
+static void io_flush(struct aiFile *f)
+{
+    (void)f;
+}
+
+static enum aiReturn io_seek(struct aiFile *f, size_t off, enum aiOrigin origin)
+{
+    io_file *h = (io_file *)f->UserData;
+    size_t base = origin == aiOrigin_SET ? 0 : origin == aiOrigin_CUR ? h->pos : h->len;
+    // assimp passes negative offsets as wrapped size_t: the sum wraps back, so compare the result.
+    size_t to = base + off;
+    if (to > h->len) return aiReturn_FAILURE;
+    h->pos = to;
+    return aiReturn_SUCCESS;
+}
+
+static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char *mode)
+{
+    io_ctx *c = (io_ctx *)io->UserData;
+    if (!path || !mode || strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')) return NULL;
+    io_file *h = calloc(1, sizeof *h);
+    struct aiFile *f = calloc(1, sizeof *f);
+    if (!h || !f) {
+        free(h);
+        free(f);
+        return NULL;
+    }
+    if (c->mem_name && !strcmp(path, c->mem_name)) {
+        h->data = c->mem;
+        h->len = c->mem_len;
+    } else if (c->disk) {
+        rs_error e = {0};
+        void *data;
+        size_t len;
+        if (rs_file_read_all(path, RS_IMPORT_MAX_FILE, &data, &len, &e) != RS_OK) {
+            if (c->main && !strcmp(path, c->main)) snprintf(c->failed, sizeof c->failed, "%s", e.msg);
+            free(h);
+            free(f);
+            return NULL;
+        }
+        h->data = h->owned = data;
+        h->len = len;
+    } else {
+        free(h);
+        free(f);
+        return NULL;
+    }
+    *f = (struct aiFile){.ReadProc = io_read, .WriteProc = io_write, .TellProc = io_tell, .FileSizeProc = io_size,
+                         .SeekProc = io_seek, .FlushProc = io_flush, .UserData = (aiUserData)h};
+    return f;
+}
+
+static void io_close(struct aiFileIO *io, struct aiFile *f)
+{
+    (void)io;
+    if (!f) return;
+    io_file *h = (io_file *)f->UserData;
+    free(h->owned);
+    free(h);
+    free(f);
+}
+
+// ---- format sniffing ----
+
+static const char *ext_of(const char *path)
+{
+    const char *slash = strrchr(path, '/'), *dot = strrchr(path, '.');
+    return dot && (!slash || dot > slash) ? dot + 1 : "";
+}
+
+static bool is_ply_magic(const uint8_t *d, size_t n)
+{
+    if (n >= 3 && d[0] == 0xef && d[1] == 0xbb && d[2] == 0xbf) d += 3, n -= 3;  // UTF-8 BOM (ply.c accepts it)
+    return n >= 4 && !memcmp(d, "ply", 3) && (d[3] == '\n' || d[3] == '\r');
+}
+
+static bool contains(const uint8_t *d, size_t n, const char *s)
+{
+    size_t k = strlen(s);
+    for (size_t i = 0; i + k <= n; i++)
+        if (!memcmp(d + i, s, k)) return true;
+    return false;
+}
+
+static rs_import_format sniff(const uint8_t *d, size_t n, const char *ext)
+{
+    if (n >= 4 && !memcmp(d, "glTF", 4)) return RS_IMPORT_GLTF;
+    if (n >= 18 && !memcmp(d, "Kaydara FBX Binary", 18)) return RS_IMPORT_FBX;
+    if (!strcasecmp(ext, "gltf") || !strcasecmp(ext, "glb")) return RS_IMPORT_GLTF;
+    if (!strcasecmp(ext, "fbx")) return RS_IMPORT_FBX;
+    if (!strcasecmp(ext, "dae") || contains(d, n, "<COLLADA")) return RS_IMPORT_DAE;
+    if (!strcasecmp(ext, "stl")) return RS_IMPORT_STL;
+    if (!strcasecmp(ext, "obj")) return RS_IMPORT_OBJ;
+    return RS_IMPORT_OTHER;
+}
+
+// ---- flattening ----
+
+static float meta_number(const struct aiMetadata *m, const char *key, bool *found)
+{
+    *found = false;
+    for (unsigned i = 0; m && i < m->mNumProperties; i++) {
+        if (strcmp(m->mKeys[i].data, key) || !m->mValues[i].mData) continue;
+        const struct aiMetadataEntry *e = &m->mValues[i];
+        *found = true;
+        switch (e->mType) {
+        case AI_FLOAT: return *(const float *)e->mData;
+        case AI_DOUBLE: return (float)*(const double *)e->mData;
+        case AI_INT32: return (float)*(const int32_t *)e->mData;
+        default: *found = false; return 0;
+        }
+    }
+    return 0;
+}
+
+static const char *meta_string(const struct aiMetadata *m, const char *key)
+{
+    for (unsigned i = 0; m && i < m->mNumProperties; i++)
+        if (!strcmp(m->mKeys[i].data, key) && m->mValues[i].mType == AI_AISTRING && m->mValues[i].mData)
+            return ((const struct aiString *)m->mValues[i].mData)->data;
+    return NULL;
+}
+
+typedef struct weld_key {
+    uint32_t page;
+    uint32_t bits[5];  // position and UV bit patterns (exact matches only)
+    uint32_t id;
+} weld_key;
+
+static int cmp_weld(const void *a, const void *b)
+{
+    const weld_key *x = a, *y = b;
+    if (x->page != y->page) return x->page < y->page ? -1 : 1;
+    for (int k = 0; k < 5; k++)
+        if (x->bits[k] != y->bits[k]) return x->bits[k] < y->bits[k] ? -1 : 1;
+    return (x->id > y->id) - (x->id < y->id);
+}
+
+static uint32_t float_bits(float f)
+{
+    uint32_t u;
+    if (f == 0) f = 0;  // -0 and +0 weld
+    memcpy(&u, &f, 4);
+    return u;
+}
+
+// Merges vertices with the same page, position and UV (OBJ gives every face corner its own vertex;
+// flat-shaded files split every corner by normal). Normals of merged vertices are summed (the sampler
+// normalises them), so a flat-shaded scan is shaded smoothly; UV seams stay split as in the file.
+static rs_result weld(rs_ply_mesh *m, const uint32_t *vpage, rs_error *err)
+{
+    uint32_t n = m->vertex_count;
+    weld_key *k = rs_alloc_array(n, sizeof *k);
+    uint32_t *remap = rs_alloc_array(n, sizeof *remap);
+    if (!k || !remap) {
+        free(k);
+        free(remap);
+        return rs_fail(err, RS_ERR_NOMEM, "out of memory welding %u vertices", n);
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        k[i].page = vpage[i];
+        for (int a = 0; a < 3; a++) k[i].bits[a] = float_bits(m->pos[i][a]);
+        k[i].bits[3] = m->uv ? float_bits(m->uv[i][0]) : 0;
+        k[i].bits[4] = m->uv ? float_bits(m->uv[i][1]) : 0;
+        k[i].id = i;
+    }
+    qsort(k, n, sizeof *k, cmp_weld);
+    uint32_t out = 0;
+    for (uint32_t i = 0; i < n; i++) {
+        bool same = i > 0 && k[i].page == k[i - 1].page && !memcmp(k[i].bits, k[i - 1].bits, sizeof k[i].bits);
+        remap[k[i].id] = same ? remap[k[i - 1].id] : out++;
+    }
+    // Compact into fresh arrays (in place would overwrite unread vertices).
+    float(*pos)[3] = rs_alloc_array(out, sizeof *pos);
+    float(*nrm)[3] = m->normal ? calloc(out, sizeof *nrm) : NULL;
+    float(*uv)[2] = m->uv ? rs_alloc_array(out, sizeof *uv) : NULL;
+    uint8_t(*rgb)[3] = m->rgb ? rs_alloc_array(out, sizeof *rgb) : NULL;
+    if (!pos || (m->normal && !nrm) || (m->uv && !uv) || (m->rgb && !rgb)) {
+        free(k), free(remap), free(pos), free(nrm), free(uv), free(rgb);
+        return rs_fail(err, RS_ERR_NOMEM, "out of memory welding %u vertices", n);
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        uint32_t j = remap[i];
+        memcpy(pos[j], m->pos[i], sizeof pos[j]);
+        if (uv) memcpy(uv[j], m->uv[i], sizeof uv[j]);
+        if (rgb) memcpy(rgb[j], m->rgb[i], sizeof rgb[j]);
+        if (nrm)
+            for (int a = 0; a < 3; a++) nrm[j][a] += isfinite(m->normal[i][a]) ? m->normal[i][a] : 0;
+    }
+    for (uint32_t t = 0; t < m->tri_count; t++)
+        for (int c = 0; c < 3; c++) m->tri[t][c] = remap[m->tri[t][c]];
+    free(m->pos), free(m->normal), free(m->uv), free(m->rgb);
+    m->pos = pos, m->normal = nrm, m->uv = uv, m->rgb = rgb;
+    m->vertex_count = out;
+    free(k);
+    free(remap);
+    return RS_OK;
+}
+
+static uint8_t to_u8(float v)
+{
+    return (uint8_t)lrintf(RS_CLAMP(isfinite(v) ? v : 0.0f, 0.0f, 1.0f) * 255.0f);
+}
+
+// Vertex colours: glTF's COLOR_0 is linear by definition, the other formats carry what the scanner
+// wrote, which is sRGB (as in PLY).
+static void colour_to_srgb8(const struct aiColor4D *c, bool linear, uint8_t out[3])
+{
+    float v[3] = {c->r, c->g, c->b};
+    for (int a = 0; a < 3; a++) out[a] = to_u8(linear ? rs_linear_to_srgb(RS_CLAMP(isfinite(v[a]) ? v[a] : 0, 0, 1)) : v[a]);
+}
+
+static bool is_tri_mesh(const struct aiMesh *am)
+{
+    return (am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) && am->mNumFaces > 0 && am->mVertices;
+}
+
+// One mesh from every triangle mesh of the scene (node transforms already applied by assimp); a scene
+// with no triangles but points becomes a point cloud.
+static rs_result flatten(const struct aiScene *sc, rs_import_scene *s, rs_error *err)
+{
+    uint64_t nv = 0, nt = 0;
+    bool any_tri = false, all_normals = true, any_uv = false, any_rgb = false;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++)
+        any_tri |= sc->mMeshes[i] && is_tri_mesh(sc->mMeshes[i]);
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *am = sc->mMeshes[i];
+        if (!am || !am->mVertices) continue;
+        if (any_tri && !is_tri_mesh(am)) {
+            s->points_dropped += am->mNumVertices;
+            continue;
+        }
+        nv += am->mNumVertices;
+        nt += any_tri ? am->mNumFaces : 0;
+        all_normals &= am->mNormals != NULL;
+        any_uv |= am->mTextureCoords[0] != NULL && am->mNumUVComponents[0] >= 2;
+        any_rgb |= am->mColors[0] != NULL;
+    }
+    if (nv == 0) return rs_fail(err, RS_ERR_FORMAT, "%s: no geometry (no triangles or points) in the file", s->path);
+    if (nv > RS_IMPORT_MAX_VERTICES || nt > RS_IMPORT_MAX_TRIANGLES)
+        return rs_fail(err, RS_ERR_LIMIT, "%s: %llu vertices and %llu triangles, more than the %u and %u allowed", s->path,
+                       (unsigned long long)nv, (unsigned long long)nt, RS_IMPORT_MAX_VERTICES, RS_IMPORT_MAX_TRIANGLES);
+    if (sc->mNumMaterials > RS_IMPORT_MAX_PAGES)
+        return rs_fail(err, RS_ERR_LIMIT, "%s: %u materials, more than the %d allowed", s->path, sc->mNumMaterials, RS_IMPORT_MAX_PAGES);
+
+    rs_ply_mesh *m = calloc(1, sizeof *m);
+    if (!m) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    s->mesh = m;
+    m->comments = calloc(1, 1);
+    m->pos = rs_alloc_array(nv, sizeof *m->pos);
+    m->normal = all_normals ? rs_alloc_array(nv, sizeof *m->normal) : NULL;
+    m->uv = any_uv ? rs_alloc_array(nv, sizeof *m->uv) : NULL;
+    m->rgb = any_rgb ? rs_alloc_array(nv, sizeof *m->rgb) : NULL;
+    m->tri = nt ? rs_alloc_array(nt, sizeof *m->tri) : NULL;
+    uint16_t *tpage = nt ? rs_alloc_array(nt, sizeof *tpage) : NULL;
+    uint32_t *vpage = rs_alloc_array(nv, sizeof *vpage);
+    if (!m->comments || !m->pos || (all_normals && !m->normal) || (any_uv && !m->uv) || (any_rgb && !m->rgb) ||
+        (nt && (!m->tri || !tpage)) || !vpage) {
+        free(tpage);
+        free(vpage);
+        return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory for %llu vertices", s->path, (unsigned long long)nv);
+    }
+    bool linear = s->format == RS_IMPORT_GLTF;
+    uint32_t v0 = 0, t0 = 0;
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *am = sc->mMeshes[i];
+        if (!am || !am->mVertices || (any_tri && !is_tri_mesh(am))) continue;
+        uint32_t page = am->mMaterialIndex < sc->mNumMaterials ? am->mMaterialIndex : 0;
+        for (unsigned v = 0; v < am->mNumVertices; v++) {
+            uint32_t j = v0 + v;
+            m->pos[j][0] = am->mVertices[v].x, m->pos[j][1] = am->mVertices[v].y, m->pos[j][2] = am->mVertices[v].z;
+            if (m->normal)
+                m->normal[j][0] = am->mNormals[v].x, m->normal[j][1] = am->mNormals[v].y, m->normal[j][2] = am->mNormals[v].z;
+            if (m->uv) {
+                bool has = am->mTextureCoords[0] && am->mNumUVComponents[0] >= 2;
+                m->uv[j][0] = has ? am->mTextureCoords[0][v].x : 0;
+                m->uv[j][1] = has ? am->mTextureCoords[0][v].y : 0;
+            }
+            if (m->rgb) {
+                if (am->mColors[0]) colour_to_srgb8(&am->mColors[0][v], linear, m->rgb[j]);
+                else m->rgb[j][0] = 200, m->rgb[j][1] = 178, m->rgb[j][2] = 160;
+            }
+            vpage[j] = page;
+        }
+        for (unsigned f = 0; any_tri && f < am->mNumFaces; f++) {
+            const struct aiFace *fc = &am->mFaces[f];
+            if (fc->mNumIndices != 3 || !fc->mIndices) continue;  // points or lines inside a triangle mesh
+            bool ok = true;
+            for (int c = 0; c < 3; c++) ok &= fc->mIndices[c] < am->mNumVertices;
+            if (!ok)
+                return free(tpage), free(vpage),
+                       rs_fail(err, RS_ERR_FORMAT, "%s: mesh %u face %u: vertex index out of range", s->path, i, f);
+            for (int c = 0; c < 3; c++) m->tri[t0][c] = v0 + fc->mIndices[c];
+            tpage[t0++] = (uint16_t)page;
+        }
+        v0 += am->mNumVertices;
+    }
+    m->vertex_count = v0;
+    m->tri_count = t0;
+    if (t0 == 0) {
+        free(m->tri);
+        m->tri = NULL;
+        free(tpage);
+        tpage = NULL;
+    }
+    rs_result r = RS_OK;
+    if (m->tri) r = weld(m, vpage, err);
+    free(vpage);
+    if (r != RS_OK) {
+        free(tpage);
+        return r;
+    }
+    if (sc->mNumMaterials > 1 && tpage) m->tri_page = tpage;
+    else free(tpage);
+    return RS_OK;
+}
+
+// Base-colour texture of each material: glTF's baseColorTexture, else the diffuse map (MTL map_Kd, FBX,
+// DAE); embedded images ("*N", or a file name matching an embedded texture's) point into the scene.
+static rs_result collect_pages(const struct aiScene *sc, rs_import_scene *s, rs_error *err)
+{
+    s->page_count = sc->mNumMaterials;
+    if (!s->page_count) return RS_OK;
+    s->pages = calloc(s->page_count, sizeof *s->pages);
+    if (!s->pages) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    for (uint32_t i = 0; i < s->page_count; i++) {
+        const struct aiMaterial *mat = sc->mMaterials[i];
+        rs_import_page *p = &s->pages[i];
+        struct aiString name = {0};
+        if (mat && aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
+            snprintf(p->name, sizeof p->name, "%.*s", (int)RS_MIN(name.length, sizeof p->name - 1), name.data);
+        struct aiString path = {0};
+        bool have = false;
+        enum aiTextureType types[2] = {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE};
+        for (int k = 0; k < 2 && !have && mat; k++)
+            have = aiGetMaterialTexture(mat, types[k], 0, &path, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS &&
+                   path.length > 0 && path.length < sizeof path.data;
+        if (!have) continue;
+        const struct aiTexture *tex = NULL;
+        if (path.data[0] == '*') {
+            char *end;
+            long idx = strtol(path.data + 1, &end, 10);
+            if (end == path.data + 1 || *end || idx < 0 || (unsigned long)idx >= sc->mNumTextures)
+                return rs_fail(err, RS_ERR_FORMAT, "%s: material '%s' names embedded texture '%s', which does not exist",
+                               s->path, p->name, path.data);
+            tex = sc->mTextures[idx];
+        } else {
+            const char *want = strrchr(path.data, '/') ? strrchr(path.data, '/') + 1 : path.data;
+            for (unsigned t = 0; t < sc->mNumTextures && !tex; t++) {
+                const struct aiTexture *c = sc->mTextures[t];
+                if (!c || !c->mFilename.length) continue;
+                const char *fn = strrchr(c->mFilename.data, '/') ? strrchr(c->mFilename.data, '/') + 1 : c->mFilename.data;
+                if (!strcmp(fn, want)) tex = c;
+            }
+        }
+        if (tex) {
+            if (tex->mHeight != 0 || !tex->pcData)
+                return rs_fail(err, RS_ERR_FORMAT, "%s: material '%s': embedded texture is raw texels, not a PNG or JPEG file",
+                               s->path, p->name);
+            p->embedded = (const uint8_t *)tex->pcData;
+            p->embedded_len = tex->mWidth;
+        } else {
+            p->texture = strdup(path.data);
+            if (!p->texture) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+        }
+    }
+    return RS_OK;
+}
+
+// The unit the format declares (after assimp's own conversions: COLLADA's <unit> is applied to the
+// root node, FBX's UnitScaleFactor is not).
+static void declared_unit(const struct aiScene *sc, rs_import_scene *s)
+{
+    bool found;
+    switch (s->format) {
+    case RS_IMPORT_GLTF:
+        s->declared_mm_per_unit = 1000.0f;
+        snprintf(s->unit_source, sizeof s->unit_source, "glTF: metres by definition");
+        break;
+    case RS_IMPORT_DAE:
+        s->declared_mm_per_unit = 1000.0f;
+        snprintf(s->unit_source, sizeof s->unit_source, "COLLADA <unit>, converted to metres by assimp");
+        break;
+    case RS_IMPORT_FBX: {
+        float cm = meta_number(sc->mMetaData, "UnitScaleFactor", &found);
+        if (found && cm > 0 && isfinite(cm) && cm < 1e6f) {
+            s->declared_mm_per_unit = 10.0f * cm;
+            snprintf(s->unit_source, sizeof s->unit_source, "FBX UnitScaleFactor %g (cm per unit)", cm);
+        }
+        break;
+    }
+    default: break;
+    }
+}
+
+// The file's own leading comment lines (an OBJ's '#' header usually carries the author and licence),
+// and glTF's asset copyright / generator, become the mesh comments (they go into the .rsf notes).
+static void collect_comments(const struct aiScene *sc, const uint8_t *head, size_t n, rs_import_scene *s)
+{
+    char buf[1024];
+    size_t len = 0;
+    buf[0] = 0;
+    if (s->format == RS_IMPORT_OBJ) {
+        for (size_t i = 0; i < n && head[i] == '#';) {
+            size_t e = i;
+            while (e < n && head[e] != '\n') e++;
+            size_t b = i + 1;
+            while (b < e && (head[b] == ' ' || head[b] == '\t')) b++;
+            size_t l = e - b;
+            while (l && (head[b + l - 1] == '\r' || head[b + l - 1] == ' ')) l--;
+            if (l && len + l + 2 < sizeof buf) {
+                if (len) buf[len++] = '\n';
+                memcpy(buf + len, head + b, l);
+                len += l;
+                buf[len] = 0;
+            }
+            i = e + 1;
+        }
+    }
+    const char *keys[2] = {"SourceAsset_Copyright", "SourceAsset_Generator"};
+    const char *labels[2] = {"copyright: ", "generator: "};
+    for (int k = 0; k < 2; k++) {
+        const char *v = meta_string(sc->mMetaData, keys[k]);
+        if (v && *v) len += (size_t)snprintf(buf + len, sizeof buf - RS_MIN(len, sizeof buf - 1), "%s%s%s", len ? "\n" : "", labels[k], v);
+        len = RS_MIN(len, sizeof buf - 1);
+    }
+    if (len) {
+        char *c = strdup(buf);
+        if (c) {
+            free(s->mesh->comments);
+            s->mesh->comments = c;
+        }
+    }
+}
+
+static rs_result import_assimp(rs_import_scene *s, io_ctx *ctx, const char *name, const uint8_t *head, size_t head_len,
+                               rs_error *err)
+{
+    ctx->main = name;
+    struct aiFileIO io = {.OpenProc = io_open, .CloseProc = io_close, .UserData = (aiUserData)ctx};
+    struct aiPropertyStore *props = aiCreatePropertyStore();
+    if (!props) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    // Only what a static surface needs: no animation, bones or lights are read where the format allows.
+    aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_FBX_READ_ANIMATIONS, 0);
+    aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_FBX_READ_CAMERAS, 0);
+    aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_FBX_READ_LIGHTS, 0);
+    aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_FBX_READ_WEIGHTS, 0);
+    aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_LINE);
+    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_PreTransformVertices |
+                     aiProcess_ValidateDataStructure;
+    const struct aiScene *sc = aiImportFileExWithProperties(name, flags, &io, props);
+    aiReleasePropertyStore(props);
+    if (!sc) {
+        const char *why = aiGetErrorString();
+        if (ctx->failed[0]) return rs_fail(err, RS_ERR_IO, "%s", ctx->failed);
+        return rs_fail(err, RS_ERR_FORMAT, "%s: not a model rouge-pack can read (PLY, OBJ, glTF/GLB, FBX, STL, DAE and the "
+                                           "other formats assimp reads): %s", s->path, why && *why ? why : "unknown error");
+    }
+    s->priv = (void *)sc;
+    s->v_flipped = s->format == RS_IMPORT_GLTF;
+    if (s->format == RS_IMPORT_OTHER) {
+        const char *fmt = meta_string(sc->mMetaData, "SourceAsset_Format");
+        snprintf(s->format_name, sizeof s->format_name, "%s", fmt && *fmt ? fmt : "model");
+    }
+    rs_result r = flatten(sc, s, err);
+    if (r == RS_OK) r = collect_pages(sc, s, err);
+    if (r != RS_OK) return r;
+    declared_unit(sc, s);
+    collect_comments(sc, head, head_len, s);
+    return RS_OK;
+}
+
+static rs_import_scene *scene_new(const char *path)
+{
+    rs_import_scene *s = calloc(1, sizeof *s);
+    if (s) snprintf(s->path, sizeof s->path, "%s", path);
+    return s;
+}
+
+rs_result rs_import_load(const char *path, rs_import_scene **out, rs_error *err)
+{
+    // The head of the file, read non-blocking from a regular file only (a FIFO would block the read).
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+        close(fd);
+        return rs_fail(err, RS_ERR_IO, "%s: not a regular file", path);
+    }
+    uint8_t head[4096];
+    ssize_t got = read(fd, head, sizeof head);
+    close(fd);
+    if (got < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    const char *ext = ext_of(path);
+    rs_import_scene *s = scene_new(path);
+    if (!s) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    rs_result r;
+    if (is_ply_magic(head, (size_t)got) || !strcasecmp(ext, "ply")) {
+        s->format = RS_IMPORT_PLY;
+        r = rs_ply_load(path, &s->mesh, err);
+    } else if (got == 0) {
+        r = rs_fail(err, RS_ERR_FORMAT, "%s: file is empty", path);
+    } else {
+        s->format = sniff(head, (size_t)got, ext);
+        io_ctx ctx = {.disk = true};
+        r = import_assimp(s, &ctx, path, head, (size_t)got, err);
+    }
+    if (!s->format_name[0]) snprintf(s->format_name, sizeof s->format_name, "%s", rs_import_format_name(s->format));
+    if (r != RS_OK) {
+        rs_import_destroy(s);
+        return r;
+    }
+    *out = s;
+    return RS_OK;
+}
+
+rs_result rs_import_load_memory(const void *data, size_t len, const char *hint, rs_import_scene **out, rs_error *err)
+{
+    char name[32];
+    snprintf(name, sizeof name, "model.%s", hint && *hint ? hint : "bin");
+    rs_import_scene *s = scene_new(name);
+    if (!s) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    rs_result r;
+    if (is_ply_magic(data, len)) {
+        s->format = RS_IMPORT_PLY;
+        r = rs_ply_load_memory(data, len, &s->mesh, err);
+    } else if (len == 0) {
+        r = rs_fail(err, RS_ERR_FORMAT, "%s: file is empty", name);
+    } else {
+        s->format = sniff(data, RS_MIN(len, (size_t)4096), ext_of(name));
+        io_ctx ctx = {.mem_name = name, .mem = data, .mem_len = len};
+        r = import_assimp(s, &ctx, name, data, RS_MIN(len, (size_t)4096), err);
+    }
+    if (!s->format_name[0]) snprintf(s->format_name, sizeof s->format_name, "%s", rs_import_format_name(s->format));
+    if (r != RS_OK) {
+        rs_import_destroy(s);
+        return r;
+    }
+    *out = s;
+    return RS_OK;
+}
+
+void rs_import_destroy(rs_import_scene *s)
+{
+    if (!s) return;
+    rs_ply_destroy(s->mesh);
+    for (uint32_t i = 0; i < s->page_count && s->pages; i++) free(s->pages[i].texture);
+    free(s->pages);
+    if (s->priv) aiReleaseImport(s->priv);
+    free(s);
+}
+
+// ---- textures ----
+
+// A texture path from a material: relative to the model's folder; Windows separators are accepted, and
+// when the path does not exist (an absolute path from the machine that made the file) the bare file name
+// next to the model is tried.
+static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *p, rs_image *out, rs_error *err)
+{
+    char rel[1024];
+    snprintf(rel, sizeof rel, "%s", p->texture);
+    for (char *c = rel; *c; c++)
+        if (*c == '\\') *c = '/';
+    char dir[4096];
+    snprintf(dir, sizeof dir, "%s", s->path);
+    char *slash = strrchr(dir, '/');
+    if (slash) slash[1] = 0;
+    else dir[0] = 0;
+    char full[8192];
+    const char *base = strrchr(rel, '/') ? strrchr(rel, '/') + 1 : rel;
+    const char *tries[2] = {rel, base};
+    for (int k = 0; k < 2; k++) {
+        if (tries[k][0] == '/') snprintf(full, sizeof full, "%s", tries[k]);
+        else snprintf(full, sizeof full, "%s%s", dir, tries[k]);
+        struct stat st;
+        if (stat(full, &st) != 0) continue;
+        rs_result r = rs_image_load_any(full, out, err);
+        if (r != RS_OK) {
+            char why[sizeof err->msg];
+            snprintf(why, sizeof why, "%s", err->msg);
+            return rs_fail(err, r, "%s: material '%s': texture %s", s->path, p->name, why);
+        }
+        return RS_OK;
+    }
+    return rs_fail(err, RS_ERR_IO, "%s: material '%s' names the texture '%s', which is not there (looked in '%s'); "
+                                   "pass --texture FILE to use another image", s->path, p->name, p->texture, dir[0] ? dir : "./");
+}
+
+rs_result rs_import_load_pages(const rs_import_scene *s, rs_image **out, rs_error *err)
+{
+    *out = NULL;
+    if (!s->page_count) return RS_OK;
+    rs_image *pages = calloc(s->page_count, sizeof *pages);
+    if (!pages) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    for (uint32_t i = 0; i < s->page_count; i++) {
+        const rs_import_page *p = &s->pages[i];
+        rs_result r = RS_OK;
+        if (p->embedded) {
+            char name[160];
+            snprintf(name, sizeof name, "%s: material '%s': embedded texture", s->path, p->name);
+            r = rs_image_decode_any(p->embedded, p->embedded_len, name, &pages[i], err);
+        } else if (p->texture) {
+            r = load_page_file(s, p, &pages[i], err);
+        }
+        if (r != RS_OK) {
+            rs_import_free_pages(pages, s->page_count);
+            return r;
+        }
+    }
+    *out = pages;
+    return RS_OK;
+}
+
+void rs_import_free_pages(rs_image *pages, uint32_t count)
+{
+    for (uint32_t i = 0; pages && i < count; i++) rs_image_free(&pages[i]);
+    free(pages);
+}
