@@ -9,16 +9,20 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-// <bin>/../share/rouge/NAME for the running program (what `make install` lays out); false if unknown.
-static bool installed_path(const char *name, char *buf, size_t n)
+// <prefix>/REL for the running program, <prefix> being the folder above the one holding it (<bin>/..,
+// textually: a path through a missing folder would not resolve); false if unknown.
+static bool beside_bin(const char *rel, char *buf, size_t n)
 {
     char exe[512];
     ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
     if (len <= 0) return false;
     exe[len] = 0;
-    char *slash = strrchr(exe, '/');
-    if (slash) *slash = 0;
-    snprintf(buf, n, "%s/../share/rouge/%s", exe, name);
+    for (int k = 0; k < 2; k++) {
+        char *slash = strrchr(exe, '/');
+        if (!slash) return false;
+        *slash = 0;
+    }
+    snprintf(buf, n, "%s/%s", exe, rel);
     return true;
 }
 
@@ -26,17 +30,16 @@ const char *rs_app_default_face(char *buf, size_t n)
 {
     snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
     if (access(buf, R_OK) == 0) return buf;
-    if (!installed_path("face.rsf", buf, n) || access(buf, R_OK) != 0) snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
+    if (!beside_bin("share/rouge/face.rsf", buf, n) || access(buf, R_OK) != 0) snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
     return buf;
 }
 
 const char *rs_app_env_dir(char *buf, size_t n)
 {
-    if (!installed_path("env", buf, n)) return NULL;
-    if (access(buf, R_OK) == 0) return buf;
-    // A program run from a source tree's build directory, from anywhere: <tree>/build/../assets/env.
-    installed_path("../../assets/env", buf, n);
-    return access(buf, R_OK) == 0 ? buf : NULL;
+    if (beside_bin("share/rouge/env", buf, n) && access(buf, R_OK) == 0) return buf;
+    // A program run from a source tree's build directory, from anywhere: <tree>/assets/env.
+    if (beside_bin("assets/env", buf, n) && access(buf, R_OK) == 0) return buf;
+    return NULL;
 }
 
 rouge_view rs_app_public_view(const rs_view *v, const char *env)

@@ -187,6 +187,27 @@ static void draw_loading(vw_viewer *v)
     rs_ui_text(v->ui, cx - w * 0.5f, cy + 22 * s, ts, RS_UI_WHITE, line);
 }
 
+// The lighting environments as chips under the top bar (issue 12): a tap relights the face.
+static void draw_env_chips(vw_viewer *v, const rs_ui_toolbar_layout *l)
+{
+    float s = v->ui_scale, h = 30 * s, pad = 6 * s, g = 4 * s;
+    int n = rs_env_name_count();
+    float w[8] = {0}, total = 0;
+    int ts = RS_MAX(1, (int)floorf(s * 2 + 0.25f));  // rs_ui_text_button's label scale
+    for (int i = 0; i < n && i < 8; i++) total += (w[i] = rs_ui_text_width(rs_env_name(i), ts) + 24 * s);
+    total += g * (float)(n - 1) + 2 * pad;
+    rs_ui_rect panel = {l->top.x + (l->top.w - total) * 0.5f, l->top.y + l->top.h + 6 * s, total, h + 2 * pad};
+    rs_ui_panel(v->ui, panel, (h + 2 * pad) * 0.5f);
+    float x = panel.x + pad;
+    for (int i = 0; i < n && i < 8; i++) {
+        const char *name = rs_env_name(i);
+        bool on = strcmp(name, v->env_name) == 0;
+        if (rs_ui_text_button(v->ui, 4100 + i, (rs_ui_rect){x, panel.y + pad, w[i], h}, name, on) && !on)
+            vw_set_env(v, name);
+        x += w[i] + g;
+    }
+}
+
 rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
 {
     rs_ui_input in = {.x = v->mx, .y = v->my, .down = v->ui_owns[0], .pressed = v->ui_pressed,
@@ -222,6 +243,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         .mobile = v->view.pipeline == RS_PIPELINE_MOBILE,
     };
     rs_ui_tool t = rs_ui_toolbar(v->ui, &l, st, swatch);
+    draw_env_chips(v, &l);
     draw_hud(v, &l);
     draw_toast(v, &l);
     draw_help(v);

@@ -33,6 +33,24 @@ expect cli_out_of_range 2 "--size" "$rouge" render "$face" -o "$tmp/a.png" --siz
 expect cli_bad_mode 2 "--mode: unknown value 'shiny'" "$rouge" render "$face" -o "$tmp/a.png" --mode shiny
 expect cli_missing_value 2 "--zoom needs a value" "$rouge" render "$face" -o "$tmp/a.png" --zoom
 expect cli_no_output 2 "no output" "$rouge" render "$face"
+# Lighting environments (issue 12): --help names them; an unknown one, a missing or corrupt .rse file get one
+# line, a non-zero exit and no picture; rouge-env refuses what is not an HDR latitude-longitude map.
+if "$rouge" --help 2>&1 | grep -q "studio|daylight|office|sunset|paper"; then echo "ok - cli_help_lists_environments"
+else echo "FAIL - cli_help_lists_environments: --help lacks studio|daylight|office|sunset|paper"; fi
+expect cli_env_unknown 2 "environment 'nosuch': not one of" "$rouge" render "$face" -o "$tmp/env.png" --env nosuch
+no_file cli_env_unknown_leaves_no_output "$tmp/env.png"
+expect cli_env_missing_file 1 "missing.rse" "$rouge" render "$face" -o "$tmp/env.png" --env "$tmp/missing.rse"
+head -c 5000 assets/env/studio.rse >"$tmp/cut.rse"
+expect cli_env_truncated 1 "cut.rse" "$rouge" render "$face" -o "$tmp/env.png" --env "$tmp/cut.rse"
+no_file cli_env_truncated_leaves_no_output "$tmp/env.png"
+expect cli_env_rotate_range 2 "--env-rotate" "$rouge" render "$face" -o "$tmp/env.png" --env-rotate 1000
+printf '#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 99999 +X 199998\n' >"$tmp/huge.hdr"
+expect env_tool_huge_claim 1 "huge.hdr" "$build/rouge-env" "$tmp/huge.hdr" -o "$tmp/h.rse" --name huge
+no_file env_tool_huge_leaves_no_output "$tmp/h.rse"
+printf 'v/1\001garbage' >"$tmp/bad.exr"
+expect env_tool_bad_exr 1 "bad.exr" "$build/rouge-env" "$tmp/bad.exr" -o "$tmp/h.rse" --name bad
+no_file env_tool_bad_exr_leaves_no_output "$tmp/h.rse"
+expect env_tool_no_name 2 "needs IN" "$build/rouge-env" "$tmp/bad.exr" -o "$tmp/h.rse"
 expect cli_missing_face 1 "cannot open" "$rouge" render "$tmp/none.rsf" -o "$tmp/b.png"
 no_file cli_missing_face_leaves_no_output "$tmp/b.png"
 expect cli_directory_as_face 1 "not a regular file" "$rouge" render "$tmp" -o "$tmp/c.png"

@@ -5,6 +5,7 @@
 // (albedo) floor skipping shadows and diffusion, and the usual robustness checks on the new paths.
 // The bench (make bench) runs the whole set: 8 views x 2 lights x 2 modes.
 #include "support/harness.h"
+#include "formats/env_lookup.h"
 #include "render/render.h"
 
 #include <math.h>
@@ -165,6 +166,59 @@ static void test_mobile_matches_reference_within_tolerance_at_512(void)
     RS_CHECK(drawn > 0 && drawn < face->hdr.count, "mobile drew %u of %u splats", drawn, face->hdr.count);
     RS_CHECK(psnr_sum / n >= 38.0, "mean PSNR %.2f dB over %d views", psnr_sum / n, n);
     RS_CHECK(de_sum / n <= 1.5, "mean CIEDE2000 %.3f over %d views", de_sum / n, n);
+}
+
+// The same tolerance under environments (issue 12): two bundled environments of different character
+// (outdoor daylight with a broad key and a blue sky; sunset with a low sun and a pink sky), four views
+// each over both modes, environment specular and SH irradiance x occlusion on both sides.
+static void test_mobile_matches_reference_under_environments(void)
+{
+    if (!need_face()) return;
+    static const char *envs[] = {"daylight", "sunset"};
+    static const struct {
+        int view;
+        rs_render_mode mode;
+    } set[] = {{0, RS_MODE_FULL}, {3, RS_MODE_FULL}, {7, RS_MODE_FULL}, {2, RS_MODE_DIFFUSE}};
+    for (size_t e = 0; e < RS_COUNT_OF(envs); e++) {
+        rs_env *env = NULL;
+        rs_error err = {0};
+        RS_REQUIRE(rs_env_open(envs[e], NULL, &env, &err) == RS_OK, "%s", err.msg);
+        rs_result r = rs_render_set_env(ren, env, &err);
+        rs_env_destroy(env);
+        RS_REQUIRE(r == RS_OK, "%s", err.msg);
+        double psnr_sum = 0, de_sum = 0;
+        int n = 0;
+        for (size_t i = 0; i < RS_COUNT_OF(set); i++) {
+            rs_view v = test_view(set[i].mode, 512);
+            v.yaw_deg = views[set[i].view][0], v.pitch_deg = views[set[i].view][1];
+            rs_image ref = {0}, mob = {0};
+            v.pipeline = RS_PIPELINE_REFERENCE;
+            bool ok = render(ren, &v, &ref);
+            v.pipeline = RS_PIPELINE_MOBILE;
+            ok = ok && render(ren, &v, &mob);
+            rs_image_metrics m = {0};
+            ok = ok && RS_CHECK(rs_image_compare(&ref, &mob, 8, &m, &err) == RS_OK, "%s", err.msg);
+            if (ok) {
+                double p = isinf(m.psnr) ? 99.0 : m.psnr;
+                psnr_sum += p, de_sum += m.delta_e, n++;
+                if (!RS_CHECK(p >= 34.0 && m.ssim >= 0.97, "%s view %d: PSNR %.2f dB, SSIM %.4f", envs[e],
+                              set[i].view, p, m.ssim)) {
+                    char name[64];
+                    snprintf(name, sizeof name, "mobile_env_%s_v%d", envs[e], set[i].view);
+                    save_pair(name, &ref, &mob);
+                }
+            }
+            rs_image_free(&ref);
+            rs_image_free(&mob);
+            if (!ok) break;
+        }
+        if (n == 0) break;
+        printf("# %s: mobile vs reference at 512x512, %d views: mean PSNR %.2f dB, mean CIEDE2000 %.3f\n", envs[e], n,
+               psnr_sum / n, de_sum / n);
+        RS_CHECK(psnr_sum / n >= 38.0, "%s: mean PSNR %.2f dB", envs[e], psnr_sum / n);
+        RS_CHECK(de_sum / n <= 1.5, "%s: mean CIEDE2000 %.3f", envs[e], de_sum / n);
+    }
+    rs_render_set_env(ren, NULL, NULL);
 }
 
 // ---- the K-Gaussian fit ----
@@ -475,6 +529,7 @@ int main(int argc, char **argv)
     RS_RUN(test_mobile_rgba8_fallback_runs_and_is_close);
     RS_RUN(test_k3_fit_matches_six_gaussians_at_a_shadow_edge);
     RS_RUN(test_mobile_matches_reference_within_tolerance_at_512);
+    RS_RUN(test_mobile_matches_reference_under_environments);
     rs_render_destroy(ren);
     rs_splat_destroy(face);
     rs_gl_destroy(gl);

@@ -183,7 +183,8 @@ typedef struct light {
 } light;
 
 // The brightest compact region: the peak of a 64x32 copy (about 6 degrees a texel), then every texel of
-// the full map within 30 degrees of it brighter than a quarter of the peak's mean. Its excess over the
+// the full map within 30 degrees of it brighter than a quarter of the peak's mean and than 1/20 of the
+// brightest texel there. Its excess over the
 // level around it (a 10-degree ring outside the region) becomes the light; the texels keep that level.
 static rs_result extract_light(map *m, light *out, rs_error *err)
 {
@@ -199,8 +200,19 @@ static rs_result extract_light(map *m, light *out, rs_error *err)
     map_free(&small);
 
     const float cos_reach = cosf(30.0f * PI_F / 180.0f);
-    float threshold = 0.25f * peak_lum;
     size_t n = (size_t)m->w * (size_t)m->h;
+    // A sun is far brighter than the sky it sits in, which the coarse copy averages it with: the
+    // threshold also follows the full-resolution peak near the coarse one, so the light is the sun's
+    // disc and not the bright sky around it; a softbox (about uniform) keeps all of its area.
+    float fine_peak = 0.0f;
+    for (int j = 0; j < m->h; j++)
+        for (int i = 0; i < m->w; i++) {
+            float d[3];
+            texel_dir(m, i, j, d);
+            if (d[0] * peak[0] + d[1] * peak[1] + d[2] * peak[2] >= cos_reach)
+                fine_peak = RS_MAX(fine_peak, lum(m->rgb + ((size_t)j * (size_t)m->w + (size_t)i) * 3));
+        }
+    float threshold = RS_MAX(0.25f * peak_lum, 0.05f * fine_peak);
     uint8_t *in = calloc(n, 1);
     if (!in) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
     float max_angle = 0.0f;
@@ -371,8 +383,11 @@ static rs_result write_preview(const rs_env *e, const char *path, rs_error *err)
 
 static int usage(const char *msg)
 {
-    if (msg) fprintf(stderr, "rouge-env: %s\n", msg);
-    fprintf(msg ? stderr : stdout,
+    if (msg) {
+        fprintf(stderr, "rouge-env: %s (see --help)\n", msg);
+        return 2;
+    }
+    fprintf(stdout,
             "usage: rouge-env IN.exr|IN.hdr -o OUT.rse --name NAME [--key-yaw DEG] [--notes TEXT] [--preview PNG]\n"
             "  Turns a latitude-longitude HDR capture (width = 2 x height, OpenEXR scanline R,G,B or Radiance\n"
             "  .hdr) into a rouge lighting environment: the brightest compact region becomes the key light\n"
@@ -380,7 +395,7 @@ static int usage(const char *msg)
             "  and radiance prefiltered for roughness %.2f..%.2f. NAME: a-z 0-9 _ -. --preview writes the\n"
             "  map with the light as a PNG to check it.\n",
             level_m[0], level_m[LEVELS - 1]);
-    return msg ? 2 : 0;
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -407,7 +422,7 @@ int main(int argc, char **argv)
                     return usage("--key-yaw: a number of degrees in -360..360");
             }
         } else if (a[0] == '-') {
-            fprintf(stderr, "rouge-env: unknown option '%s'\n", a);
+            fprintf(stderr, "rouge-env: unknown option '%s' (see --help)\n", a);
             return 2;
         } else if (!in) {
             in = a;
