@@ -52,7 +52,7 @@ SOMAJOR  := 0
 SONAME   := librouge.so.$(SOMAJOR)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 
-.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall
+.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall import-fixtures
 all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES)
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
@@ -135,6 +135,15 @@ TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(sort $(wildcard tests/supp
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a $(PACK_LIBS)) $(TEST_LIBS) $(LDFLAGS) -o $@
+
+# Regenerates the committed import fixtures that need JPEG encoding (tests/fixtures/import/head/, *.jpg)
+# from ../shared/data (tools/make_import_fixtures.c; the rest come from tests/fixtures/import/make_fixtures.py).
+$(BUILD)/make-import-fixtures: tools/make_import_fixtures.c $(BUILD)/libpack.a $(BUILD)/librouge.a
+	$(CC) $(CFLAGS) $(PKG_CFLAGS) $(PACK_CFLAGS) -Isrc -Itools $< $(BUILD)/libpack.a $(PACK_LIBS) $(LIBS) $(LDFLAGS) -o $@
+
+import-fixtures: $(BUILD)/make-import-fixtures
+	mkdir -p tests/fixtures/import/head
+	$(BUILD)/make-import-fixtures ../shared/data/leeperrysmith tests/fixtures/import
 
 run: deps
 	@$(MAKE) --no-print-directory all

@@ -137,8 +137,9 @@ static void test_bad_models_fail_with_one_line(void)
     static const struct {
         const char *file, *want;
     } cases[] = {
-        {FX "bad_truncated.glb", "not a model rouge-pack can read"},
-        {FX "bad_not_a_model.obj", "not a model rouge-pack can read"},
+        {FX "bad_truncated.glb", "bad glTF 2.0 file (assimp: "},
+        {FX "bad_not_a_model.obj", "bad Wavefront OBJ file (assimp: "},
+        {"tests/fixtures/image/a_8x8.png", "not a model rouge-pack can read (PLY, OBJ, glTF/GLB"},
         {FX "no_such_file.obj", "cannot open"},
         {"/dev/zero", "not a regular file"},
         {FX, "not a regular file"},
@@ -232,6 +233,37 @@ static void test_lee_perry_smith_glb_matches_ply(void)
     rs_import_destroy(s);
 }
 
+static void test_jpeg_and_png_textures_decode_with_limits(void)
+{
+    rs_error err = {0};
+    rs_image img = {0};
+    RS_REQUIRE(rs_image_load_any(FX "yellow 16.jpg", &img, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(img.width == 16 && img.height == 16 && img.channels == 3 && abs(img.pixels[0] - 240) < 6 &&
+                 abs(img.pixels[1] - 200) < 6 && abs(img.pixels[2] - 20) < 8,
+             "%dx%d, %u %u %u", img.width, img.height, img.pixels[0], img.pixels[1], img.pixels[2]);
+    rs_image_free(&img);
+    RS_CHECK(rs_image_load_any(FX "page one.png", &img, &err) == RS_OK && img.pixels[0] == 220, "%s", err.msg);
+    rs_image_free(&img);
+    static const struct {
+        const char *file, *want;
+        rs_result code;
+    } bad[] = {
+        {FX "bad_truncated.jpg", "JPEG is truncated", RS_ERR_FORMAT},
+        {FX "bad_huge.jpg", "16000x16000 = 256.0 Mpx, more than the 67 Mpx allowed", RS_ERR_LIMIT},
+        {FX "bad_bomb.jpg", "cannot hold that much data", RS_ERR_FORMAT},
+        {FX "two_pages.obj", "not a PNG or JPEG file (starts 23 20 72 6f)", RS_ERR_FORMAT},
+        {"tests/fixtures/bad/png_huge_dimensions.png", "larger than the 16384 allowed", RS_ERR_LIMIT},
+        {"tests/fixtures/bad/png_truncated.png", "truncated", RS_ERR_FORMAT},
+        {"/dev/zero", "not a regular file", RS_ERR_IO},
+    };
+    for (size_t i = 0; i < RS_COUNT_OF(bad); i++) {
+        img = (rs_image){0};
+        rs_result r = rs_image_load_any(bad[i].file, &img, &err);
+        RS_CHECK(r == bad[i].code && !img.pixels && strstr(err.msg, bad[i].want), "%s: %s (%s)", bad[i].file, err.msg,
+                 rs_result_name(r));
+    }
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -241,6 +273,7 @@ int main(int argc, char **argv)
     RS_RUN(test_stl_and_ply_route);
     RS_RUN(test_bad_models_fail_with_one_line);
     RS_RUN(test_memory_import_matches_file);
+    RS_RUN(test_jpeg_and_png_textures_decode_with_limits);
     RS_RUN(test_lee_perry_smith_glb_matches_ply);
     return rs_test_finish();
 }

@@ -162,6 +162,23 @@ bad_input pack_texture_huge_png "--texture: PNG header claiming 10^6 x 10^6 pixe
     -o "$tmp/o.rsf"
 bad_input pack_texture_dev_zero "--texture /dev/zero" 1 "/dev/zero" "$tmp/o.rsf" \
     "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture /dev/zero -o "$tmp/o.rsf"
+bad_input import_glb_truncated "GLB cut inside its binary chunk" 1 "bad glTF 2.0 file" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/import/bad_truncated.glb -o "$tmp/o.rsf"
+head -c 100000 tests/fixtures/import/head/head.obj >"$tmp/cut.obj"
+bad_input import_obj_truncated "OBJ cut in the middle of a line (first 100000 bytes)" 1 "bad Wavefront OBJ file" \
+    "$tmp/o.rsf" "$pack" "$tmp/cut.obj" -o "$tmp/o.rsf"
+bad_input import_obj_not_a_model "OBJ that is a shopping list" 1 "bad Wavefront OBJ file" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/import/bad_not_a_model.obj -o "$tmp/o.rsf"
+bad_input import_not_a_model "a PNG given as the scan" 1 "not a model rouge-pack can read" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/image/a_8x8.png -o "$tmp/o.rsf"
+bad_input import_missing_texture "OBJ whose MTL names a missing texture" 1 "which is not there" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/import/bad_missing_texture.obj -o "$tmp/o.rsf"
+bad_input import_texture_truncated_jpeg "--texture: a JPEG cut in half" 1 "JPEG is truncated" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture tests/fixtures/import/bad_truncated.jpg -o "$tmp/o.rsf"
+bad_input import_texture_huge_jpeg "--texture: JPEG header claiming 16000 x 16000 pixels" 1 "Mpx allowed" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture tests/fixtures/import/bad_huge.jpg -o "$tmp/o.rsf"
+bad_input import_texture_jpeg_bomb "--texture: 622-byte JPEG claiming 8000 x 8000 pixels" 1 "cannot hold" "$tmp/o.rsf" \
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture tests/fixtures/import/bad_bomb.jpg -o "$tmp/o.rsf"
 bad_input pack_region_map_not_png "--region-map: a PLY instead of a PNG" 1 "--region-map" "$tmp/o.rsf" \
     "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --region-map tests/fixtures/ply/points_le.ply \
     -o "$tmp/o.rsf"

@@ -528,8 +528,11 @@ static rs_result import_assimp(rs_import_scene *s, io_ctx *ctx, const char *name
     if (!sc) {
         const char *why = aiGetErrorString();
         if (ctx->failed[0]) return rs_fail(err, RS_ERR_IO, "%s", ctx->failed);
+        if (!why || !*why) why = "unknown error";
+        if (s->format != RS_IMPORT_OTHER)
+            return rs_fail(err, RS_ERR_FORMAT, "%s: bad %s file (assimp: %s)", s->path, rs_import_format_name(s->format), why);
         return rs_fail(err, RS_ERR_FORMAT, "%s: not a model rouge-pack can read (PLY, OBJ, glTF/GLB, FBX, STL, DAE and the "
-                                           "other formats assimp reads): %s", s->path, why && *why ? why : "unknown error");
+                                           "other formats assimp reads; assimp: %s)", s->path, why);
     }
     s->priv = (void *)sc;
     s->v_flipped = s->format == RS_IMPORT_GLTF;
