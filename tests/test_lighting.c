@@ -78,9 +78,12 @@ static double mean_luma(const rs_image *img, const uint8_t *mask)
     return n ? s / n : 0;
 }
 
+// Replays a stroke file at its own 256x256 view under the default environment.
 static bool replay(const char *strokes)
 {
     rouge_error e = {0};
+    rouge_view v = {.width = 256, .height = 256};
+    if (!RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg)) return false;
     rouge_face_clear(face, NULL);
     return RS_CHECK(rouge_face_play_strokes(face, strokes, &e) == ROUGE_OK, "%s: %s", strokes, e.msg);
 }
@@ -276,6 +279,40 @@ static void test_bad_environments_fail_cleanly(void)
     RS_CHECK(rouge_face_render(face, &e) == ROUGE_OK, "render after refusals: %s", e.msg);
 }
 
+// Issue 15: an opaque liner reaches near-black in one stroke. A straight eyeliner line across the cheek
+// (painted in a 256x256 frontal view, seen at 512x512): along its centre line, away from its ends,
+// luminance <= 40/255.
+static void test_opaque_liner_reaches_near_black(void)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/liner.strokes", rs_test_out_dir());
+    FILE *f = fopen(path, "w");
+    RS_REQUIRE(f, "cannot write %s", path);
+    fprintf(f, "rouge-strokes 1\nview yaw=0 pitch=0 zoom=1 fov=30 size=256x256\n"
+               "brush size=0.03 opacity=1 pressure=none mirror=0 eraser=0\ncosmetic eyeliner\nstroke\n");
+    for (int i = 0; i <= 40; i++) fprintf(f, "s %.4f %.2f 150.00 1.000\n", i / 60.0, 76.0 + i);
+    fprintf(f, "end\n");
+    fclose(f);
+    if (!replay(path)) return;
+    // Looked at twice as closely as painted (the line is a few pixels wide at 256).
+    rouge_view v = rouge_face_get_view(face);
+    v.width = v.height = 512;
+    rs_image img = {0};
+    if (render(&v, &img)) {
+        int worst = 0;
+        for (int x = 168; x <= 216; x++) {
+            const uint8_t *p = img.pixels + ((size_t)300 * img.width + x) * 4;
+            int l = (int)lrint(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]);
+            worst = RS_MAX(worst, l);
+        }
+        printf("# opaque eyeliner: brightest centre-line pixel %d/255\n", worst);
+        RS_CHECK(worst <= 40, "eyeliner centre line reaches %d/255 (want <= 40: near-black)", worst);
+        rs_test_save("lighting_eyeliner", &img);
+    }
+    rs_image_free(&img);
+    rouge_face_clear(face, NULL);
+}
+
 // ---- the file and the math ----
 
 // SH projection of a known environment (as rouge-env computes it) evaluates to the brute-force
@@ -363,6 +400,7 @@ int main(int argc, char **argv)
     RS_RUN(test_every_environment_renders_and_differs);
     RS_RUN(test_env_rotation_moves_the_light);
     RS_RUN(test_bad_environments_fail_cleanly);
+    RS_RUN(test_opaque_liner_reaches_near_black);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
     return rs_test_finish();

@@ -197,6 +197,46 @@ static void test_normals_on_demosthenes_agree_with_given(void)
     rs_ply_destroy(m);
 }
 
+// Ambient occlusion (pack_ao.c) against analytic answers: a flat floor sees the whole upper hemisphere
+// (1); the bottom of a hemispherical bowl sees the sky through its rim at 45 degrees from the axis, a
+// cosine-weighted fraction of sin^2(45) = 0.5; a splat under a lid sees nothing above (0 within the
+// sampling's reach).
+static void test_ambient_occlusion_matches_analytic_cases(void)
+{
+    enum { K = 60, BOWL = 4000 };
+    rs_splat *s = calloc(K * K + BOWL + 1, sizeof *s);
+    uint8_t *ao = malloc(K * K + BOWL + 1);
+    RS_REQUIRE(s && ao, "out of memory");
+    // A floor (z = 0, normal +z), 2 x 2 units, well away from the bowl.
+    for (int y = 0; y < K; y++)
+        for (int x = 0; x < K; x++) {
+            rs_splat *p = &s[y * K + x];
+            p->pos[0] = -6.0f + 2.0f * x / (K - 1), p->pos[1] = 2.0f * y / (K - 1), p->normal[2] = 1.0f;
+            p->radius = 2.0f / K;
+        }
+    // A bowl of radius 1 centred at (3, 0, 1): the lower hemisphere, normals pointing inwards (to the centre).
+    uint32_t bottom = K * K;
+    for (int i = 0; i < BOWL; i++) {
+        float z = -1.0f + (float)i / BOWL, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.39996323f * (float)i;
+        rs_splat *p = &s[K * K + i];
+        float d[3] = {r * cosf(phi), r * sinf(phi), z};
+        for (int a = 0; a < 3; a++) p->pos[a] = d[a] + (a == 0 ? 3.0f : a == 2 ? 1.0f : 0.0f), p->normal[a] = -d[a];
+        p->radius = 0.04f;
+        if (i == 0) bottom = K * K + i;
+    }
+    rs_error err = {0};
+    RS_REQUIRE(rs_pack_ao(s, K * K + BOWL, ao, &err) == RS_OK, "%s", err.msg);
+    double floor_mean = 0;
+    for (int i = 0; i < K * K; i++) floor_mean += ao[i] / 255.0;
+    floor_mean /= K * K;
+    float b = ao[bottom] / 255.0f;
+    printf("# ambient occlusion: floor %.3f (1), bowl bottom %.3f (0.5)\n", floor_mean, b);
+    RS_CHECK(floor_mean > 0.97, "open floor: AO %.3f, want ~1", floor_mean);
+    RS_CHECK(fabsf(b - 0.5f) < 0.1f, "bowl bottom: AO %.3f, want 0.5", b);
+    free(s);
+    free(ao);
+}
+
 static void test_radius_matches_grid_spacing(void)
 {
     // A 60x60 grid of spacing h: the 8th neighbour of an interior point is a diagonal one, sqrt(2) h.
@@ -786,6 +826,7 @@ int main(int argc, char **argv)
     RS_RUN(test_non_face_is_framed_by_its_bounding_sphere);
     RS_RUN(test_normals_on_demosthenes_agree_with_given);
     RS_RUN(test_radius_matches_grid_spacing);
+    RS_RUN(test_ambient_occlusion_matches_analytic_cases);
     RS_RUN(test_lod_prefix_is_spatially_uniform);
     RS_RUN(test_lod_prefix_covers_surface);
     RS_RUN(test_morton_order_keeps_levels_compact);

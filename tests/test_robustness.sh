@@ -94,7 +94,7 @@ done <<'EOF'
 rsf_wrong_magic.rsf|magic:|wrong magic "RSX\0"
 rsf_version_2.rsf|unsupported version 2|version 2
 rsf_header_size_wrong.rsf|header_size:|header_size disagrees with notes_len
-rsf_flags_set.rsf|flags:|reserved flags set
+rsf_flags_set.rsf|flags:|unknown flags set
 rsf_count_zero.rsf|count:|0 splats
 rsf_count_past_end.rsf|count:|count larger than the file holds
 rsf_nan_bbox.rsf|bbox_min[0]:|NaN in the bounding box
@@ -111,7 +111,7 @@ rsf_region_m_nan.rsf|regions[0].m:|NaN roughness
 rsf_region_rho_negative.rsf|regions[1].rho_s:|negative rho_s
 rsf_notes_len_huge.rsf|notes_len:|notes_len 0xFFFFFFF0
 rsf_notes_bad_utf8.rsf|notes:|notes not UTF-8
-rsf_record_flags.rsf|splat 0:|reserved record bits set
+rsf_record_flags.rsf|splat 0:|ambient occlusion byte without the header flag
 rsf_trailing_bytes.rsf|after the CRC|16 bytes after the CRC
 EOF
 bad_input rsf_bad_crc ".rsf: one payload bit flipped (CRC kept)" 1 "crc: stored" "$tmp/o.png" \

@@ -397,7 +397,7 @@ static void test_create_rejects_bad_header_tables(void)
     h = (rs_splat_header){0};
     strcpy(h.notes, "caf\xc3");  // UTF-8 cut in the middle of a character
     expect_create_fails(s, 20, &h, RS_ERR_ARG, "notes");
-    h = (rs_splat_header){.flags = 1};
+    h = (rs_splat_header){.flags = 2};  // bit 0 is RS_SPLAT_FLAG_AO; bit 1 is unknown
     expect_create_fails(s, 20, &h, RS_ERR_ARG, "flags");
     h = (rs_splat_header){.forward = {0, 0, 2}, .up = {0, 0, -1}};
     expect_create_fails(s, 20, &h, RS_ERR_ARG, "up");
@@ -765,7 +765,7 @@ static void test_other_header_fields_are_checked(void)
 {
     field_case cases[] = {
         {8, false, 0, 624, "header_size: 624, expected 608", "(byte 8)"},
-        {12, false, 0, 1, "flags: 0x00000001", "(byte 12)"},
+        {12, false, 0, 2, "flags: 0x00000002", "(byte 12)"},
         {52, true, 0.0f, 0, "mm_per_unit: 0", "(byte 52)"},
         {52, true, INFINITY, 0, "mm_per_unit: inf", "(byte 52)"},
         {60, true, NAN, 0, "centre[1]: nan", "(byte 60)"},
@@ -803,7 +803,8 @@ static void test_record_region_and_flags_are_checked_naming_the_splat(void)
     b[SMALL_HEADER + 16 * 17 + 7] = 4;
     b[SMALL_HEADER + 16 * 49 + 15] = 0x80;  // flags byte of the last splat
     fix_crc(b, len);
-    expect_reject(b, len, RS_ERR_FORMAT, "splat 49: flags 0x80", "(byte 1407)");
+    expect_reject(b, len, RS_ERR_FORMAT, "splat 49: byte 15 is 0x80 but the header has no ambient occlusion",
+                  "(byte 1407)");
     free(b);
 }
 

@@ -13,6 +13,7 @@
 //   build/rouge-bench --build build [--data ../shared/data] [--quick] [--face assets/face.rsf]
 #define _DEFAULT_SOURCE  // wait4 (per-child peak memory)
 
+#include "formats/env_lookup.h"
 #include "makeup/makeup.h"
 #include "render/render.h"
 #include "splat/splat.h"
@@ -522,6 +523,44 @@ static void frame_rows(bench *b, rs_gl_context *gl)
     for (int c = 0; c < CFG_COUNT; c++) rs_render_destroy(r[c]);
 }
 
+// What lighting by an environment costs the mobile frame (issue 12: at most ~15%): the default
+// environment against the paper's lamp, same view, two renderers timed frame by frame in turn.
+static void env_row(bench *b, rs_gl_context *gl)
+{
+    const char *what = "environment cost, mobile frame 512x512";
+    rs_renderer *r[2] = {NULL, NULL};
+    rs_env *env = NULL;
+    rs_error err = {0};
+    bool ok = rs_env_open(RS_ENV_DEFAULT, NULL, &env, &err) == RS_OK;
+    for (int k = 0; ok && k < 2; k++)
+        ok = rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r[k], &err) == RS_OK;
+    ok = ok && rs_render_set_env(r[0], env, &err) == RS_OK;
+    rs_env_destroy(env);
+    static double ms[2][64];
+    int frames = RS_MIN(b->frames, 64);
+    for (int i = -1; ok && i < frames; i++)
+        for (int k = 0; ok && k < 2; k++) {
+            rs_view v = rs_view_defaults();
+            v.width = v.height = 512;
+            v.pipeline = RS_PIPELINE_MOBILE;
+            v.lighting = k == 0 ? RS_LIGHTING_ENV : RS_LIGHTING_LIGHTS;
+            double t0 = rs_time_now();
+            ok = rs_render_frame(r[k], &v, &err) == RS_OK;
+            glFinish();
+            if (i >= 0) ms[k][i] = (rs_time_now() - t0) * 1000.0;
+        }
+    if (ok) {
+        double e = median(ms[0], frames), p = median(ms[1], frames);
+        char notes[200];
+        snprintf(notes, sizeof notes, "environment `%s` (SH x AO into stage 4, prefiltered specular, coat) vs "
+                 "`paper` (one lamp); goal (issue 12): <= ~15%% more; median of %d", RS_ENV_DEFAULT, frames);
+        add_row(b, what, notes, "%.1f ms vs %.1f ms (%+.0f%%)", e, p, (e / p - 1.0) * 100.0);
+    } else {
+        add_row(b, what, NULL, "n/a (%s)", err.msg);
+    }
+    for (int k = 0; k < 2; k++) rs_render_destroy(r[k]);
+}
+
 // Where a frame's time goes, per stage (glFinish after each stage: slower overall, so separate rows).
 static void stage_rows(bench *b, rs_gl_context *gl)
 {
@@ -768,6 +807,8 @@ int main(int argc, char **argv)
         snprintf(b->rows[gl_row].notes, sizeof b->rows[gl_row].notes, "%s, %s; float targets %s",
                  caps->platform, caps->version, caps->float_rt ? "yes" : "no");
         frame_rows(b, gl);
+        progress("environment cost");
+        env_row(b, gl);
         progress("per-stage timings");
         stage_rows(b, gl);
         quality_rows(b, r);

@@ -52,6 +52,8 @@ static const char usage[] =
     "Output:\n"
     "  -o, --output FILE   the .rsf to write (atomically: no file is left on failure)\n"
     "  --min-lod N         smallest LOD prefix listed (default 10000)\n"
+    "  --no-ao             skip the per-splat ambient occlusion (environment lighting then treats every\n"
+    "                      splat as open to the sky: eye sockets and nostrils lit like the cheek)\n"
     "  --seed S            random seed for sampling (default 20240600); same seed, same file\n"
     "  --preview PNG       also write a CPU preview: front colour, front regions, side regions\n"
     "  -q, --quiet         no progress bar, no summary\n"
@@ -119,7 +121,7 @@ static void show_progress(void *user, rs_pack_step step, double f)
     for (int i = 0; i < 30; i++) bar[i] = i < full ? '#' : '.';
     bar[30] = 0;
     fprintf(stderr, "\r  %-10s [%s] %3d%%", rs_pack_step_name(step), bar, pct);
-    if (step == RS_PACK_STEP_ENCODE && pct == 100) fputs("\r\033[K", stderr);
+    if ((step == RS_PACK_STEP_ENCODE || step == RS_PACK_STEP_AO) && pct == 100) fputs("\r\033[K", stderr);
     fflush(stderr);
 }
 
@@ -380,6 +382,9 @@ int main(int argc, char **argv)
             takes = false;
         } else if (!strcmp(a, "--all-components")) {
             o.desc.all_components = true;
+            takes = false;
+        } else if (!strcmp(a, "--no-ao")) {
+            o.desc.no_ao = true;
             takes = false;
         } else if (a[0] == '-' && a[1] != 0) {
             static const char *const known[] = {"-o", "--output", "--points", "--texture", "--normal-map",

@@ -57,7 +57,7 @@ static const rs_cosmetic presets[] = {
      0.25f, 0.0f, 0.40f},
     // Lip gloss: colourless (colour weight 0: the record's colour intensity stays 0), a clear wet coat:
     // a full clear-coat lobe (the sharp window/softbox reflections) over a smoother lip lobe.
-    {"lip_gloss", RS_COSMETIC_LIP_GLOSS, {255, 255, 255}, 0.60f, 0.00f, 1.00f, 0.14f, 0.55f, 0.08f, 0.80f,
+    {"lip_gloss", RS_COSMETIC_LIP_GLOSS, {255, 255, 255}, 0.60f, 0.00f, 1.00f, 0.12f, 0.65f, 0.08f, 0.80f,
      1.00f, 0.0f, 0.0f},
     // Eyeshadows: brown matte (the paper's Fig. 12), plum satin, champagne shimmer. Lid-sized brush.
     {"eyeshadow_brown", RS_COSMETIC_EYESHADOW, {122, 82, 62}, 0.55f, 1.00f, 0.80f, 0.38f, 0.12f, 0.07f, 0.60f,
@@ -68,7 +68,7 @@ static const rs_cosmetic presets[] = {
      0.0f, 0.60f, 0.0f},
     // Eyeliner: near-black, opaque (coverage 1: its black is not lifted to the face's darkest colour),
     // fine hard line; liquid liner dries to a soft sheen (a faint coat).
-    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.30f, 0.22f, 0.02f, 0.90f,
+    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.30f, 0.22f, 0.02f, 1.00f,
      0.15f, 0.0f, 1.00f},
 };
 
@@ -100,7 +100,7 @@ static float clamp01(float x) { return isfinite(x) ? RS_CLAMP(x, 0.0f, 1.0f) : 0
 static const float finishes[RS_FINISH_COUNT][4] = {
     [RS_FINISH_MATTE] = {0.45f, 0.07f, 0.0f, 0.0f},
     [RS_FINISH_SATIN] = {0.27f, 0.28f, 0.25f, 0.0f},
-    [RS_FINISH_GLOSS] = {0.14f, 0.55f, 1.0f, 0.0f},
+    [RS_FINISH_GLOSS] = {0.12f, 0.65f, 1.0f, 0.0f},
     [RS_FINISH_SHIMMER] = {0.21f, 0.45f, 0.0f, 0.8f},
 };
 static const char *const finish_names[RS_FINISH_COUNT] = {"matte", "satin", "gloss", "shimmer"};

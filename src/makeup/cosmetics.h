@@ -52,8 +52,8 @@ typedef struct rs_cosmetic {
     float coat;              // clear-coat weight 0..1: a smooth, untinted second lobe (gloss; F0 0.04, m 0.1)
     float shimmer;           // flake sparkle 0..1: tiny pigment-tinted mirrors that glint (highlighter)
     float coverage;          // 0 sheer .. 1 opaque: an opaque pigment keeps its own colour (not held in the
-                             // face's range), hides the skin texture and reaches full intensity (eq. 3's 0.9
-                             // ceiling lifted to 1); docs/makeup.md
+                             // face's range), hides the skin texture and deposits fully in one stroke (eq. 3
+                             // moves towards the brush footprint alone); docs/makeup.md
 } rs_cosmetic;
 
 // Finish families (docs/makeup.md): what a product editor offers. Each sets m, rho_s, coat, shimmer.

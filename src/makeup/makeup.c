@@ -271,9 +271,7 @@ static prepared prepare(const colour_tables *t, const rs_cosmetic *c)
 static void compose(const colour_tables *t, rs_makeup_gpu *rec, const prepared *c, float amount, uint8_t detail)
 {
     float a = clamp01(amount);
-    // Eq. (3) tops out at 0.9 (three terms of 0.3): right for sheer products, which never hide the skin.
-    // Coverage lifts that ceiling to 1 for an opaque product (a liner, a full-coverage lipstick).
-    float i2 = RS_MIN(a * c->colour_w * (1.0f + c->coverage * (1.0f / 0.9f - 1.0f)), 1.0f);
+    float i2 = a * c->colour_w;
     if (i2 > 0.0f) {
         // eq. (2) stacked: I' = 1 - (1-I1)(1-I2), Cp' = (Cp1 I1 (1-I2) + Cp2 I2) / I', linear light.
         float i1 = rec->colour_i / 255.0f;
@@ -714,8 +712,17 @@ static void stamp_splat(stamp_ctx *x, uint32_t i)
         if (x->cos && mk->touch[i] < 255) mk->touch[i]++;
     }
     stroke_slot *sl = &mk->slots[s];
-    float a = x->cos ? x->amount * rs_makeup_intensity(ig, x->cos->material_w, mk->touch_w[mk->touch[i]])
-                     : x->amount * RS_MIN(1.0f, 2.0f * ig);  // eraser: flat top, full erase in the inner half
+    float a;
+    if (x->cos) {
+        // Coverage v moves eq. (3) towards a hard-edged footprint: an opaque product (v = 1) deposits
+        // fully over the inner part of the brush (I_G x 3, capped: a liner's solid line, its rim still
+        // soft), a sheer one (v = 0) builds up by eq. (3).
+        float v = x->cos->coverage;
+        float i3 = rs_makeup_intensity(ig, x->cos->material_w, mk->touch_w[mk->touch[i]]);
+        a = x->amount * (i3 + v * (RS_MIN(1.0f, ig * (1.0f + 2.0f * v)) - i3));
+    } else {
+        a = x->amount * RS_MIN(1.0f, 2.0f * ig);  // eraser: flat top, full erase in the inner half
+    }
     if (!(a > sl->amount)) return;  // the stroke opacity cap: max over the stroke's stamps
     sl->amount = a;
     rs_makeup_gpu r = sl->before;

@@ -19,7 +19,7 @@
 // ~pi (3 sigma)^2 / spacing^2.
 //
 // The level loop is generic over rs_diffusion_level. The mobile pipeline (docs/mobile.md) plugs in its K
-// fitted Gaussians (rs_profile_fit at the half-pixel footprint, cached per K), a larger lod_factor (2),
+// fitted Gaussians (rs_profile_fit at the frame's typical kernel floor, cached per K), a larger lod_factor (2),
 // takes every Gaussian below the kernel floor as per-pixel irradiance, and draws the levels that remain
 // at half or quarter resolution; the resolve upsamples them depth-aware (diffusion_resolve.frag.glsl).
 // On the bundled head at 512x512 that leaves one level (sigma ~1.7 mm, the 74k prefix, 128x128).
@@ -52,6 +52,16 @@
 // of the reduced target.
 #define RES_MIN_SIGMA 0.5f
 
+// The typical kernel floor of the frame (model units): half the median radius of the main passes' prefix
+// or half a pixel at the face, whichever is larger. The mobile fit and the level plan both use it, so the
+// Gaussians the fit is made for are the ones the renderer draws (issue 12).
+static float typical_floor(const rs_renderer *r, const rs_frame *f)
+{
+    float lod_scale = rs_splat_lod_radius_scale(r->cloud, f->count);
+    float dist = glm_vec3_distance((float *)f->cam.eye, (float *)r->cloud->hdr.centre);
+    return 0.5f * fmaxf(r->radius_median * lod_scale, f->cam.px_size * dist);
+}
+
 // The coarsest LOD prefix (at most the main passes' count) whose typical radius is <= factor * sigma.
 static uint32_t level_count(const rs_renderer *r, const rs_frame *f, float sigma, float factor)
 {
@@ -73,10 +83,8 @@ static void frame_profile(rs_renderer *r, const rs_frame *f, rs_profile *out, fl
     if (f->view.pipeline != RS_PIPELINE_MOBILE) return;
     int k = f->view.kernel_count > 0 ? f->view.kernel_count : RS_PROFILE_DEFAULT_COUNT;
     k = RS_CLAMP(k, RS_PROFILE_FIT_MIN, RS_PROFILE_FIT_MAX);
-    // Fit at the half-pixel footprint (mm) at the face centre, cached per K while the footprint stays
-    // within 10%.
-    float dist = glm_vec3_distance((float *)f->cam.eye, (float *)r->cloud->hdr.centre);
-    float footprint = 0.5f * f->cam.px_size * dist * r->cloud->hdr.mm_per_unit;
+    // Fit at the kernel floor (mm) the plan below uses, cached per K while it stays within 10%.
+    float footprint = typical_floor(r, f) * r->cloud->hdr.mm_per_unit;
     if (!(fabsf(r->fit_footprint[k] - footprint) <= 0.1f * footprint)) {
         rs_profile fit;
         if (rs_profile_fit(k, footprint, &fit, NULL, NULL) != RS_OK) return;
@@ -98,14 +106,12 @@ int rs_render_diffusion_plan(rs_renderer *r, const rs_frame *f, rs_diffusion_lev
     // (The kernels' radii are the prefix's sqrt(N / n) ones in both pipelines: they measure the spacing.)
     float lod_scale = rs_splat_lod_radius_scale(r->cloud, f->count);
     float floor_sigma = 0.5f * fmaxf(h->radius_min * lod_scale, 1.0f / f->cam.ppu_max);
-    // The typical floor: half the median radius or half a pixel at the face.
-    float dist = glm_vec3_distance((float *)f->cam.eye, (float *)h->centre);
-    float typical_floor = 0.5f * fmaxf(r->radius_median * lod_scale, f->cam.px_size * dist);
+    float floor_typ = typical_floor(r, f);
     delta_weight[0] = delta_weight[1] = delta_weight[2] = 0.0f;
     int n = 0;
     for (int i = 0; i < prof.count; i++) {
         float sigma = sqrtf(prof.variance_mm2[i]) / h->mm_per_unit;
-        if (sigma <= (f->mobile ? DELTA_BELOW_MOBILE : DELTA_BELOW_REFERENCE) * typical_floor) {
+        if (sigma <= (f->mobile ? DELTA_BELOW_MOBILE : DELTA_BELOW_REFERENCE) * floor_typ) {
             for (int c = 0; c < 3; c++) delta_weight[c] += prof.weight[i][c];
             continue;
         }
@@ -127,7 +133,7 @@ int rs_render_diffusion_plan(rs_renderer *r, const rs_frame *f, rs_diffusion_lev
             // Wide levels at half or quarter resolution: the level's kernel (at least half the typical
             // radius of its prefix) spans at least RES_MIN_SIGMA of the reduced target's pixels at the face.
             float sigma_eff = fmaxf(l->sigma, 0.5f * r->radius_median * scale);
-            float px = f->cam.px_size * dist;
+            float px = f->cam.px_size * glm_vec3_distance((float *)f->cam.eye, (float *)h->centre);
             while (l->res_div < 4 && sigma_eff >= RES_MIN_SIGMA * px * (float)(2 * l->res_div))
                 l->res_div *= 2;
         }

@@ -132,7 +132,8 @@ typedef struct rs_frame {
     vec3 fill_dir, fill_color;   // fill_color zero when off
     vec3 ambient;
     mat4 shadow_matrix;      // view space -> light clip space
-    float shadow_bias, shadow_offset, shadow_texel;
+    mat3 shadow_normals;     // view-space normals -> light clip space (inverse transpose)
+    float shadow_bias, shadow_texel;
     float delta_weight[3];   // profile weight taken by per-pixel irradiance (stage 4's narrow Gaussians)
     bool env_on;             // lit by the renderer's environment (its light is then the key light)
     mat3 env_from_view;      // view-space directions -> the environment's frame (rotation included)

@@ -121,12 +121,14 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
     f->shadow_texel = texel_pcf / (2.0f * R);
     // A disk departs from the surface it samples by ~r^2 / 2R at its rim (curvature radius R ~ 0.3 of
     // the face height on cheeks and nose) plus r sin(3 deg) from normal noise: ~0.15 r on the bundled
-    // head; a texel of quantisation on top. Depth bias in window units (the ortho range is 2.02 R).
-    f->shadow_bias = (0.15f * m->radius + texel) / (2.02f * R);
-    // Normal offset: a texel and a half (the PCF grid's step) plus the same disk departure.
-    f->shadow_offset = 1.5f * texel_pcf + 0.15f * m->radius;
-    // The PCF grid reaches 3.25 texels sideways: on slopes that is depth too.
-    f->shadow_bias += 1.5f * texel_pcf / (2.02f * R);
+    // head; a texel of quantisation on top. Depth bias in window units (the ortho range is 2.02 R). The
+    // slope is the receiver plane's, per PCF tap (shadow_lookup.glsl): no normal offset.
+    f->shadow_bias = (0.5f * m->radius + texel) / (2.02f * R);
+    // Normals into light clip space: the inverse transpose of the view -> light clip map's linear part.
+    mat3 a, inv;
+    glm_mat4_pick3(f->shadow_matrix, a);
+    glm_mat3_inv(a, inv);
+    glm_mat3_transpose_to(inv, f->shadow_normals);
     return rs_gl_check("render: shadow map", err);
 }
 
@@ -138,6 +140,6 @@ void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint p
     glUniformMatrix4fv(rs_uloc(prog, "u_shadow_matrix"), 1, GL_FALSE, (const float *)f->shadow_matrix);
     glUniform1f(rs_uloc(prog, "u_shadow_texel"), f->shadow_texel);
     glUniform1f(rs_uloc(prog, "u_shadow_bias"), f->shadow_bias);
-    glUniform1f(rs_uloc(prog, "u_shadow_offset"), f->shadow_offset);
+    glUniformMatrix3fv(rs_uloc(prog, "u_shadow_normals"), 1, GL_FALSE, (const float *)f->shadow_normals);
     glUniform3fv(rs_uloc(prog, "u_shadow_dir"), 1, f->key_dir);
 }

@@ -324,7 +324,7 @@ static rs_result encode_file(const rs_splat_cloud *c, const char *name, void **o
     if (r != RS_OK) return r;
     for (uint32_t i = 0; i < h->count; i++) {
         const uint32_t *w = c->packed[i].w;
-        if ((w[1] >> 24) >= h->region_count || (w[3] >> 24) != 0)
+        if ((w[1] >> 24) >= h->region_count || ((w[3] >> 24) != 0 && !(h->flags & RS_SPLAT_FLAG_AO)))
             return rs_fail(err, RS_ERR_ARG, "%s: splat %u: region %u / flags 0x%02x out of range", name, i, w[1] >> 24,
                            w[3] >> 24);
     }

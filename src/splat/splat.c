@@ -317,7 +317,8 @@ rs_result rs_splat_check_header(const rs_splat_header *h, const char *name, bool
     check_ctx x = {name, in_file, err};
     if (h->count == 0 || h->count > RS_SPLAT_MAX_COUNT)
         return bad(&x, RSF_OFF_COUNT, "count: %u splats, must be 1..%u", h->count, RS_SPLAT_MAX_COUNT);
-    if (h->flags != 0) return bad(&x, RSF_OFF_FLAGS, "flags: 0x%08x, reserved bits must be 0", h->flags);
+    if (h->flags & ~RS_SPLAT_FLAG_AO)
+        return bad(&x, RSF_OFF_FLAGS, "flags: 0x%08x, unknown bits must be 0", h->flags);
     rs_result r;
     if ((r = check_bbox(&x, h)) != RS_OK) return r;
     if ((r = check_radius(&x, h)) != RS_OK) return r;
@@ -376,7 +377,8 @@ rs_result rs_splat_decode_all(rs_splat_cloud *c, const char *name, bool in_file,
         if (region >= h->region_count)
             return bad(&x, off + 7, "splat %u: region %u is not in the region table (%u regions)", i, region,
                        h->region_count);
-        if (flags != 0) return bad(&x, off + 15, "splat %u: flags 0x%02x, reserved bits must be 0", i, flags);
+        if (flags != 0 && !(h->flags & RS_SPLAT_FLAG_AO))
+            return bad(&x, off + 15, "splat %u: byte 15 is 0x%02x but the header has no ambient occlusion", i, flags);
         c->pos[i][0] = lo[0] + (float)(w[0] & 0xffffu) * step[0];
         c->pos[i][1] = lo[1] + (float)(w[0] >> 16) * step[1];
         c->pos[i][2] = lo[2] + (float)(w[1] & 0xffffu) * step[2];
@@ -425,7 +427,7 @@ static rs_result fill_header(rs_splat_header *h, const rs_splat_header *in, rs_e
     static const rs_splat_header none;
     if (!in) in = &none;
     memset(h, 0, sizeof *h);
-    if (in->flags != 0) return rs_fail(err, RS_ERR_ARG, "%s: flags: 0x%08x, must be 0", who, in->flags);
+    if (in->flags & ~RS_SPLAT_FLAG_AO) return rs_fail(err, RS_ERR_ARG, "%s: flags: 0x%08x, unknown bits", who, in->flags);
     if (in->lod_count > RS_SPLAT_MAX_LODS)
         return rs_fail(err, RS_ERR_ARG, "%s: lod_count: %u, at most %d", who, in->lod_count, RS_SPLAT_MAX_LODS);
     // Checked here, before the splats' region ids are checked against it.
@@ -438,6 +440,7 @@ static rs_result fill_header(rs_splat_header *h, const rs_splat_header *in, rs_e
         return rs_fail(err, RS_ERR_ARG, "%s: notes: not NUL-terminated within %d bytes", who, RS_SPLAT_MAX_NOTES);
     memcpy(h->notes, in->notes, notes_len);
 
+    h->flags = in->flags;
     h->mm_per_unit = in->mm_per_unit != 0.0f ? in->mm_per_unit : 1.0f;
     h->face_height = in->face_height;
     memcpy(h->centre, in->centre, sizeof h->centre);
@@ -599,6 +602,19 @@ void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out)
     out->rgb[1] = (uint8_t)((w[3] >> 8) & 0xffu);
     out->rgb[2] = (uint8_t)((w[3] >> 16) & 0xffu);
     out->region = (uint8_t)(w[1] >> 24);
+}
+
+void rs_splat_set_ao(rs_splat_cloud *c, const uint8_t *ao)
+{
+    for (uint32_t i = 0; i < c->hdr.count; i++)
+        c->packed[i].w[3] = (c->packed[i].w[3] & 0x00ffffffu) | (ao ? (uint32_t)ao[i] << 24 : 0u);
+    if (ao) c->hdr.flags |= RS_SPLAT_FLAG_AO;
+    else c->hdr.flags &= ~RS_SPLAT_FLAG_AO;
+}
+
+float rs_splat_ao(const rs_splat_cloud *c, uint32_t i)
+{
+    return (c->hdr.flags & RS_SPLAT_FLAG_AO) ? (float)(c->packed[i].w[3] >> 24) / 255.0f : 1.0f;
 }
 
 uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count)

@@ -45,7 +45,7 @@ typedef struct rs_splat {
 //   w[0] = x16 | y16 << 16                      position, unorm16 over the bounding box
 //   w[1] = z16 | radius8 << 16 | region8 << 24  radius log-quantized over [radius_min, radius_max]
 //   w[2] = oct_u16 | oct_v16 << 16              normal, octahedral, snorm16 (max error ~0.003 deg)
-//   w[3] = r8 | g8 << 8 | b8 << 16 | flags8 << 24   sRGB colour; flags reserved (0)
+//   w[3] = r8 | g8 << 8 | b8 << 16 | ao8 << 24      sRGB colour; ambient occlusion (0 without RS_SPLAT_FLAG_AO)
 typedef struct rs_splat_packed {
     uint32_t w[4];
 } rs_splat_packed;
@@ -69,7 +69,7 @@ typedef struct rs_splat_header {
     uint32_t lods[RS_SPLAT_MAX_LODS];
     uint32_t region_count;
     rs_region_info regions[RS_SPLAT_MAX_REGIONS];
-    uint32_t flags;                  // reserved, 0
+    uint32_t flags;                  // RS_SPLAT_FLAG_AO or 0
     char notes[RS_SPLAT_MAX_NOTES];  // attribution (CC-BY) and provenance, NUL-terminated UTF-8
 } rs_splat_header;
 
@@ -105,6 +105,10 @@ rs_result rs_splat_save_memory(const rs_splat_cloud *c, void **out_data, size_t 
 
 // Decodes record i (as the GPU sees it).
 void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out);
+// Per-splat ambient occlusion (byte 15, RS_SPLAT_FLAG_AO): sets it from ao[count] (q/255, 255 = open sky)
+// or removes it (NULL); reads it (1 when the cloud has none).
+void rs_splat_set_ao(rs_splat_cloud *c, const uint8_t *ao);
+float rs_splat_ao(const rs_splat_cloud *c, uint32_t i);
 // Largest LOD prefix from the table with at most max_count splats (the smallest level if none fits).
 uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count);
 // Radius multiplier for drawing only the first n splats: sqrt(count / n).

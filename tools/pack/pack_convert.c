@@ -7,7 +7,8 @@
 
 const char *rs_pack_step_name(rs_pack_step s)
 {
-    static const char *names[RS_PACK_STEP_COUNT] = {"sample", "neighbours", "normals", "radii", "lod", "regions", "encode"};
+    static const char *names[RS_PACK_STEP_COUNT] = {"sample", "neighbours", "normals", "radii", "lod", "regions",
+                                                    "encode", "occlusion"};
     return s < RS_PACK_STEP_COUNT ? names[s] : "?";
 }
 
@@ -366,8 +367,21 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     make_notes(hdr->notes, in->comments, d->notes);
     r = rs_splat_create(splats, n, hdr, out, err);
     if (r != RS_OK) goto out;
-    rep->splats = n;
     step_end(&c);
+    if (!d->no_ao) {
+        step_begin(&c, RS_PACK_STEP_AO);
+        uint8_t *ao = malloc(n);
+        r = ao ? rs_pack_ao(splats, n, ao, err) : rs_fail(err, RS_ERR_NOMEM, "out of memory");
+        if (r == RS_OK) rs_splat_set_ao(*out, ao);
+        free(ao);
+        if (r != RS_OK) {
+            rs_splat_destroy(*out);
+            *out = NULL;
+            goto out;
+        }
+        step_end(&c);
+    }
+    rep->splats = n;
 out:
     rs_pack_points_free(&p);
     rs_pack_knn_free(&knn);
