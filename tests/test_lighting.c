@@ -313,6 +313,57 @@ static void test_opaque_liner_reaches_near_black(void)
     rouge_face_clear(face, NULL);
 }
 
+// Pixels brighter than every one of their 8 neighbours by at least `by` (sRGB luminance): glints.
+static int glints(const rs_image *img, int by, uint8_t *mark)
+{
+    int n = 0, w = img->width, h = img->height;
+    for (int y = 1; y < h - 1; y++)
+        for (int x = 1; x < w - 1; x++) {
+            const uint8_t *p = img->pixels + ((size_t)y * w + x) * 4;
+            int l = p[0] * 54 + p[1] * 183 + p[2] * 19, ok = 1;
+            for (int k = 0; k < 9 && ok; k++) {
+                if (k == 4) continue;
+                const uint8_t *q = img->pixels + ((size_t)(y + k / 3 - 1) * w + x + k % 3 - 1) * 4;
+                ok = l >= q[0] * 54 + q[1] * 183 + q[2] * 19 + by * 256;
+            }
+            if (mark) mark[y * w + x] = (uint8_t)ok;
+            n += ok;
+        }
+    return n;
+}
+
+// A shimmer finish (highlighter) sparkles: glints appear where it lies, and they move when the light does
+// (the environment turned 30 degrees): flakes fixed on the surface catch the light at other places.
+static void test_shimmer_sparkles_and_moves_with_the_light(void)
+{
+    if (!replay(with_cosmetic("tests/fixtures/strokes/cheek.strokes", "highlighter", "shimmer.strokes"))) return;
+    rs_image img[3] = {{0}};
+    uint8_t *mark[2] = {calloc(400 * 400, 1), calloc(400 * 400, 1)};
+    rouge_error e = {0};
+    RS_REQUIRE(mark[0] && mark[1], "out of memory");
+    bool ok = RS_CHECK(rouge_face_target(face, "cheek", 0, &e) == ROUGE_OK, "%s", e.msg);
+    rouge_view v = rouge_face_get_view(face);
+    v.width = v.height = 400, v.env = "studio";
+    for (int k = 0; ok && k < 3; k++) {
+        v.env_rotation_deg = k == 1 ? 30.0f : 0.0f;
+        v.hide_makeup = k == 2;
+        ok = render(&v, &img[k]);
+    }
+    if (ok) {
+        int g0 = glints(&img[0], 10, mark[0]), g1 = glints(&img[1], 10, mark[1]), bare = glints(&img[2], 10, NULL);
+        int same = 0;
+        for (int i = 0; i < 400 * 400; i++) same += mark[0][i] && mark[1][i];
+        printf("# shimmer: %d glints (bare skin %d); turned 30 deg: %d, %d in the same place\n", g0, bare, g1, same);
+        RS_CHECK(g0 >= 40 && g0 >= 5 * (bare + 1), "shimmer: %d glints against %d on bare skin", g0, bare);
+        RS_CHECK(same * 2 < RS_MIN(g0, g1), "glints do not move with the light: %d of %d/%d stay", same, g0, g1);
+        rs_test_save("lighting_shimmer", &img[0]);
+    }
+    for (int k = 0; k < 3; k++) rs_image_free(&img[k]);
+    free(mark[0]);
+    free(mark[1]);
+    rouge_face_clear(face, NULL);
+}
+
 // ---- the file and the math ----
 
 // SH projection of a known environment (as rouge-env computes it) evaluates to the brute-force
@@ -401,6 +452,7 @@ int main(int argc, char **argv)
     RS_RUN(test_env_rotation_moves_the_light);
     RS_RUN(test_bad_environments_fail_cleanly);
     RS_RUN(test_opaque_liner_reaches_near_black);
+    RS_RUN(test_shimmer_sparkles_and_moves_with_the_light);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
     return rs_test_finish();

@@ -750,6 +750,63 @@ static void test_take_dirty_gives_compact_ranges_per_lod_band(void)
     rs_splat_destroy(c);
 }
 
+// Issue 15: overlapping passes build up smoothly. Two parallel foundation_3 strokes on a uniform plane,
+// the second half a brush width below the first; along a path crossing both (the CPU mirror of the shader,
+// sRGB luminance as displayed), the colour darkens without a step: on each side of its darkest point the
+// luminance is monotone within 1/255 (a band would show as a rise inside the overlap).
+static void test_overlapping_passes_build_up_without_banding(void)
+{
+    enum { K = 161 };
+    rs_splat *pl = rs_alloc_array((size_t)K * K, sizeof *pl);
+    RS_REQUIRE(pl, "out of memory");
+    float side = 1.0f, step = side / (K - 1);
+    for (int y = 0; y < K; y++)
+        for (int x = 0; x < K; x++)
+            pl[y * K + x] = (rs_splat){{-0.5f + step * x, -0.5f + step * y, 0.0f}, {0, 0, 1}, step, {214, 170, 150}, 1};
+    // The face's colour range (the pigment is held in it): a dark and a light row far from the strokes.
+    for (int x = 0; x < K; x++) {
+        pl[x].rgb[0] = 40, pl[x].rgb[1] = 28, pl[x].rgb[2] = 24;
+        pl[(K - 1) * K + x].rgb[0] = 250, pl[(K - 1) * K + x].rgb[1] = 240, pl[(K - 1) * K + x].rgb[2] = 235;
+    }
+    rs_splat_cloud *c = make_cloud(pl, K * K, frame(1.0f));
+    free(pl);
+    rs_makeup *mk = layer(c, NULL);
+    if (!mk) {
+        rs_splat_destroy(c);
+        return;
+    }
+    rs_makeup_stamp_desc d = stamp_at(0, 0, 0.2f, "foundation_3");
+    stroke_line(mk, -0.35f, 0.0f, 0.35f, 0.0f, 0.01f, d);
+    stroke_line(mk, -0.35f, -0.05f, 0.35f, -0.05f, 0.01f, d);
+    rs_makeup_uniforms u;
+    rs_makeup_get_uniforms(mk, &u);
+    // The column x = 0, from y = -0.3 to 0.25 (beyond both strokes' rims).
+    double lum[K];
+    int n = 0, darkest = 0;
+    for (int y = 0; y < K; y++) {
+        float yy = -0.5f + step * y;
+        if (yy < -0.3f || yy > 0.25f) continue;
+        uint32_t i = (uint32_t)(y * K + K / 2);
+        float a[3] = {rs_srgb_to_linear(214 / 255.0f), rs_srgb_to_linear(170 / 255.0f), rs_srgb_to_linear(150 / 255.0f)};
+        float m = 0.3f, r = 0.3f;
+        rs_makeup_apply_cpu(&rs_makeup_records(mk)[i], &u, a, &m, &r);
+        lum[n] = 255.0 * (0.2126 * rs_linear_to_srgb(a[0]) + 0.7152 * rs_linear_to_srgb(a[1]) + 0.0722 * rs_linear_to_srgb(a[2]));
+        if (lum[n] < lum[darkest]) darkest = n;
+        n++;
+    }
+    double worst = 0;
+    for (int k = 1; k < n; k++) {
+        double rise = k <= darkest ? lum[k] - lum[k - 1] : lum[k - 1] - lum[k];  // against the expected way
+        worst = fmax(worst, rise);
+    }
+    printf("# two overlapping foundation passes: %.1f -> %.1f -> %.1f (sRGB luminance), worst step against "
+           "the build-up %.2f/255\n", lum[0], lum[darkest], lum[n - 1], worst);
+    RS_CHECK(lum[0] - lum[darkest] > 20, "the passes barely show (%.1f)", lum[0] - lum[darkest]);
+    RS_CHECK(worst <= 1.0, "luminance steps %.2f/255 the wrong way: banding", worst);
+    rs_makeup_destroy(mk);
+    rs_splat_destroy(c);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -775,5 +832,6 @@ int main(int argc, char **argv)
     RS_RUN(test_nearest_respects_tolerance);
     RS_RUN(test_bad_stamps_are_refused_without_change);
     RS_RUN(test_take_dirty_gives_compact_ranges_per_lod_band);
+    RS_RUN(test_overlapping_passes_build_up_without_banding);
     return rs_test_finish();
 }
