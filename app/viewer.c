@@ -545,7 +545,11 @@ static void feed_paint(vw_viewer *v, rs_input_type type, int id, float x, float 
     if (res.stroke_end && v->rec) {
         if (rs_strokes_save(v->rec, v->cli->record, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
     }
-    mark_input(v);
+    // Navigation coarsens the picture while it moves; painting does not: the view stays, so the renderer
+    // redraws only what the stamps touched (incremental frames) at full quality.
+    bool navigated = res.orbit_dx_px != 0 || res.orbit_dy_px != 0 || res.pan_dx_px != 0 || res.pan_dy_px != 0 ||
+                     (res.zoom != 1.0f && res.zoom > 0);
+    if (navigated || !v->paint_mode) mark_input(v);
 }
 
 static void pointer_button(vw_viewer *v, int b, bool down, double t)
@@ -703,7 +707,9 @@ double vw_now(void) { return glfwGetTime(); }
 
 static bool interacting(const vw_viewer *v)
 {
-    bool held = v->scene_owns[0] || v->scene_owns[1] || v->scene_owns[2] || rs_ui_busy(v->ui);
+    // A left button held in paint mode paints (full quality, incremental frames); otherwise it orbits.
+    bool painting = v->scene_owns[0] && v->paint_mode && !v->light_drag;
+    bool held = (v->scene_owns[0] && !painting) || v->scene_owns[1] || v->scene_owns[2] || rs_ui_busy(v->ui);
     return held || vw_now() - v->last_input_s < SETTLE_S || v->frame_no - v->last_input_frame < SETTLE_FRAMES;
 }
 

@@ -44,6 +44,7 @@ typedef struct row {
 typedef struct bench {
     const char *build, *data, *face, *tmp;
     bool quick;
+    const char *only;           // --only paint|env: just those rows
     int frames;                 // per frame-time configuration
     row rows[MAX_ROWS];
     int row_count;
@@ -523,6 +524,67 @@ static void frame_rows(bench *b, rs_gl_context *gl)
     for (int c = 0; c < CFG_COUNT; c++) rs_render_destroy(r[c]);
 }
 
+// A paint frame (issue 13): one brush stamp (blush, size 0.1, on a splat facing the camera) plus the
+// frame that shows it, with the view unchanged: incremental, stages 3 and 5 inside the stamp's rectangle.
+// Against a full frame of the same view and LOD (the mobile pipeline's own density at 800x600).
+static void paint_row(bench *b, rs_gl_context *gl)
+{
+    const char *what = "paint frame, mobile 800x600";
+    rs_renderer *r = NULL;
+    rs_makeup *mk = NULL;
+    rs_error err = {0};
+    bool ok = rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r, &err) == RS_OK &&
+              rs_makeup_create(b->cloud, NULL, &mk, &err) == RS_OK;
+    rs_view v = rs_view_defaults();
+    v.width = 800, v.height = 600, v.pipeline = RS_PIPELINE_MOBILE;
+    static double full[64], paint[64];
+    int frames = RS_MIN(b->frames, 64);
+    uint32_t seed = 7, drawn = 0;
+    for (int i = -1; ok && i < frames; i++) {
+        rs_render_invalidate(r);
+        double t0 = rs_time_now();
+        ok = rs_render_frame(r, &v, &err) == RS_OK;
+        glFinish();
+        if (i >= 0) full[i] = (rs_time_now() - t0) * 1000.0;
+        drawn = rs_render_get_stats(r).splats_drawn;
+        // A stamp where the camera sees skin.
+        uint32_t k = 0;
+        float dir[3] = {0, 0, 1};
+        for (int tries = 0; tries < 1000; tries++) {
+            seed = seed * 1664525u + 1013904223u;
+            k = (seed >> 8) % drawn;
+            rs_render_view_dir(r, &v, b->cloud->pos[k], dir);
+            const float *n = b->cloud->normal[k];
+            if (n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2] > 0.7f) break;
+        }
+        rs_makeup_stamp_desc d = {.pos = {b->cloud->pos[k][0], b->cloud->pos[k][1], b->cloud->pos[k][2]},
+                                  .view_dir = {dir[0], dir[1], dir[2]}, .opacity = 0.5f, .pressure = 1.0f,
+                                  .radius = rs_makeup_brush_radius(&b->cloud->hdr, 0.1f),
+                                  .cosmetic = rs_cosmetic_find("blush")};
+        t0 = rs_time_now();
+        ok = ok && rs_makeup_stamp(mk, &d, NULL, &err) == RS_OK;
+        rs_makeup_range ranges[RS_MAKEUP_MAX_RANGES];
+        uint32_t nr = rs_makeup_take_dirty(mk, ranges, RS_MAKEUP_MAX_RANGES);
+        for (uint32_t j = 0; ok && j < nr; j++)
+            ok = rs_render_update_makeup(r, ranges[j].lo, ranges[j].hi - ranges[j].lo,
+                                         rs_makeup_records(mk) + ranges[j].lo, &err) == RS_OK;
+        ok = ok && rs_render_frame(r, &v, &err) == RS_OK;
+        glFinish();
+        if (i >= 0) paint[i] = (rs_time_now() - t0) * 1000.0;
+    }
+    if (ok) {
+        double p = median(paint, frames), f = median(full, frames);
+        char notes[240];
+        snprintf(notes, sizeof notes, "one stamp + its frame (stages 3 and 5 inside the stamp's rectangle) vs a full "
+                 "frame of the same view; %u splats drawn; goal (issue 13): ratio <= 0.25; median of %d", drawn, frames);
+        add_row(b, what, notes, "%.1f ms vs %.1f ms full, ratio R %.2f", p, f, p / f);
+    } else {
+        add_row(b, what, NULL, "n/a (%s)", err.msg);
+    }
+    rs_makeup_destroy(mk);
+    rs_render_destroy(r);
+}
+
 // What lighting by an environment costs the mobile frame (issue 12: at most ~15%): the default
 // environment against the paper's lamp, same view, two renderers timed frame by frame in turn.
 static void env_row(bench *b, rs_gl_context *gl)
@@ -744,7 +806,7 @@ static void print_table(const bench *b, FILE *f)
 static int usage(void)
 {
     fprintf(stderr, "usage: rouge-bench --build DIR [--data DIR] [--face FILE.rsf] [--tmp DIR] [--quick] "
-                    "[--out FILE.md]\n");
+                    "[--only paint|env] [--out FILE.md]\n");
     return 2;
 }
 
@@ -759,6 +821,7 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--quick")) b->quick = true;
+        else if (!strcmp(a, "--only") && v && (!strcmp(v, "paint") || !strcmp(v, "env"))) b->only = v, i++;
         else if (!v) return usage();
         else if (!strcmp(a, "--build")) b->build = v, i++;
         else if (!strcmp(a, "--data")) b->data = v, i++;
@@ -784,6 +847,21 @@ int main(int argc, char **argv)
     snprintf(ply_path, sizeof ply_path, "%s/leeperrysmith/head_points_600k.ply", b->data);
     const char *ply = file_exists(ply_path) ? ply_path : NULL;
 
+    if (b->only) {
+        rs_gl_context *gl = NULL;
+        if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
+            fprintf(stderr, "rouge-bench: %s\n", err.msg);
+            return 1;
+        }
+        add_row(b, "GL renderer", NULL, "%s", rs_gl_get_caps(gl)->renderer);
+        if (!strcmp(b->only, "paint")) paint_row(b, gl);
+        else env_row(b, gl);
+        rs_gl_destroy(gl);
+        print_table(b, stdout);
+        rs_splat_destroy(b->cloud);
+        free(b);
+        return 0;
+    }
     machine_rows(b);
     int gl_row = b->row_count;
     add_row(b, "GL renderer", NULL, "n/a");  // filled in once the context exists
@@ -809,6 +887,8 @@ int main(int argc, char **argv)
         frame_rows(b, gl);
         progress("environment cost");
         env_row(b, gl);
+        progress("paint frames");
+        paint_row(b, gl);
         progress("per-stage timings");
         stage_rows(b, gl);
         quality_rows(b, r);

@@ -488,6 +488,7 @@ static void release_targets(rs_renderer *r)
     r->diffuse_tex = r->out_tex = 0;
     r->tw = r->th = 0;
     r->have_frame = false;
+    r->inc_valid = false;
 }
 
 void rs_render_destroy(rs_renderer *r)
@@ -600,6 +601,78 @@ static void stage_mark(rs_renderer *r, int stage, double *t)
     *t = now;
 }
 
+// The fields a frame depends on (padding aside, which a caller's struct may leave undefined).
+static bool same_view(const rs_view *a, const rs_view *b)
+{
+    const rs_light *la[2] = {&a->key, &a->fill}, *lb[2] = {&b->key, &b->fill};
+    for (int i = 0; i < 2; i++)
+        if (la[i]->yaw_deg != lb[i]->yaw_deg || la[i]->pitch_deg != lb[i]->pitch_deg ||
+            la[i]->intensity != lb[i]->intensity || memcmp(la[i]->color, lb[i]->color, sizeof la[i]->color))
+            return false;
+    return a->width == b->width && a->height == b->height && a->yaw_deg == b->yaw_deg &&
+           a->pitch_deg == b->pitch_deg && a->zoom == b->zoom && a->fov_deg == b->fov_deg && a->pan[0] == b->pan[0] &&
+           a->pan[1] == b->pan[1] && a->mode == b->mode && a->pipeline == b->pipeline && a->composite == b->composite &&
+           a->exposure == b->exposure && !memcmp(a->background, b->background, sizeof a->background) &&
+           a->no_shadows == b->no_shadows && a->hide_makeup == b->hide_makeup && a->rho_s_scale == b->rho_s_scale &&
+           a->max_splats == b->max_splats && a->kernel_count == b->kernel_count && a->lod_density == b->lod_density &&
+           a->prim == b->prim && a->ambient == b->ambient && a->lighting == b->lighting &&
+           a->env_rotate_deg == b->env_rotate_deg && a->env_intensity == b->env_intensity && a->tonemap == b->tonemap &&
+           a->linear_output == b->linear_output;
+}
+
+void rs_render_invalidate(rs_renderer *r) { r->inc_valid = false; }
+uint32_t rs_render_incremental_frames(const rs_renderer *r) { return r->inc_frames; }
+
+// Grows the dirty rectangle by the splats [first, first + count) of the last full frame's prefix, as the
+// attribute pass draws them (out to RS_COVERAGE radii), plus 2 pixels: the composite's hole filling reads
+// a pixel's 3x3 neighbourhood.
+static void mark_dirty(rs_renderer *r, uint32_t first, uint32_t count)
+{
+    const rs_camera *cam = &r->inc_cam;
+    uint32_t end = RS_MIN(first + count, r->inc_count);
+    float focal = cam->proj[1][1] * 0.5f * (float)cam->height;  // pixels per unit at view distance 1
+    float *d = r->dirty;
+    for (uint32_t i = first; i < end; i++) {
+        vec4 p = {r->cloud->pos[i][0], r->cloud->pos[i][1], r->cloud->pos[i][2], 1.0f}, v, c;
+        glm_mat4_mulv((vec4 *)cam->view, p, v);
+        if (v[2] > -1e-6f) continue;  // behind the camera: not drawn
+        glm_mat4_mulv((vec4 *)cam->proj, v, c);
+        float x = (c[0] / c[3] * 0.5f + 0.5f) * (float)cam->width, y = (c[1] / c[3] * 0.5f + 0.5f) * (float)cam->height;
+        float rad = r->inc_radius * focal / -v[2] + 2.0f;
+        d[0] = fminf(d[0], x - rad), d[1] = fminf(d[1], y - rad);
+        d[2] = fmaxf(d[2], x + rad), d[3] = fmaxf(d[3], y + rad);
+    }
+}
+
+static void clear_dirty(rs_renderer *r)
+{
+    r->dirty[0] = r->dirty[1] = INFINITY;
+    r->dirty[2] = r->dirty[3] = -INFINITY;
+}
+
+// Stages 3 and 5 again inside the dirty rectangle, over the last frame's depth, shadow map and D.
+static rs_result incremental_frame(rs_renderer *r, rs_frame *f, rs_error *err)
+{
+    float *d = r->dirty;
+    int x0 = (int)floorf(fmaxf(d[0], 0.0f)), y0 = (int)floorf(fmaxf(d[1], 0.0f));
+    int x1 = (int)ceilf(fminf(d[2], (float)f->cam.width)), y1 = (int)ceilf(fminf(d[3], (float)f->cam.height));
+    clear_dirty(r);
+    r->inc_frames++;
+    if (x1 <= x0 || y1 <= y0) return RS_OK;  // nothing drawn changed
+    rs_result res = RS_OK;
+    if (f->shadows) res = rs_render_shadow(r, f, err);  // cached: sets the lookup's matrices and biases
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(x0, y0, x1 - x0, y1 - y0);
+    if (res == RS_OK) res = rs_render_attributes(r, f, err);
+    if (res == RS_OK && f->diffuse) {
+        rs_diffusion_level levels[RS_PROFILE_MAX];
+        rs_render_diffusion_plan(r, f, levels, f->delta_weight);  // the per-pixel weights; D stays
+    }
+    if (res == RS_OK) res = rs_render_composite(r, f, err);
+    glDisable(GL_SCISSOR_TEST);
+    return res;
+}
+
 rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
 {
     if (!view || view->width <= 0 || view->height <= 0 || view->width > r->caps.max_texture_size ||
@@ -630,6 +703,20 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
 
     GLint saved_viewport[4];
     glGetIntegerv(GL_VIEWPORT, saved_viewport);
+    if (r->have_frame && r->inc_valid && !r->time_stages && same_view(&f.view, &r->inc_view)) {
+        res = incremental_frame(r, &f, err);
+        glDisable(GL_BLEND);
+        glDisable(GL_DEPTH_TEST);
+        glDepthMask(GL_TRUE);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glBindVertexArray(0);
+        glUseProgram(0);
+        glActiveTexture(GL_TEXTURE0);
+        glViewport(saved_viewport[0], saved_viewport[1], saved_viewport[2], saved_viewport[3]);
+        if (res == RS_OK) res = rs_gl_check("render: incremental frame", err);
+        r->stats.frame_ms = (rs_time_now() - t_start) * 1000.0;
+        return res;
+    }
     stage_mark(r, -1, &t);
     if (f.shadows) res = rs_render_shadow(r, &f, err);
     stage_mark(r, RS_STAGE_SHADOW, &t);
@@ -662,6 +749,12 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     if (res != RS_OK) return res;
 
     r->have_frame = true;
+    r->inc_valid = true;
+    r->inc_view = f.view;
+    r->inc_cam = f.cam;
+    r->inc_count = f.count;
+    r->inc_radius = r->cloud->hdr.radius_max * f.radius_scale * RS_COVERAGE;
+    clear_dirty(r);
     r->stats.splats_drawn = f.count;
     r->stats.face_pixels = f.face_px;
     r->stats.kernel_count = nlevels;
@@ -771,6 +864,7 @@ rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_makeup);
     glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)first * (GLintptr)sizeof(rs_makeup_gpu),
                     (GLsizeiptr)count * (GLsizeiptr)sizeof(rs_makeup_gpu), records);
+    if (r->inc_valid) mark_dirty(r, first, count);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     return rs_gl_check("render: makeup upload", err);
 }
@@ -778,6 +872,7 @@ rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count
 void rs_render_set_makeup_uniforms(rs_renderer *r, const rs_makeup_uniforms *u)
 {
     r->makeup_uni = *u;
+    r->inc_valid = false;
 }
 
 rs_render_stats rs_render_get_stats(const rs_renderer *r) { return r->stats; }

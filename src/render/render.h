@@ -167,7 +167,10 @@ void rs_render_view_dir(const rs_renderer *r, const rs_view *view, const float p
 // Projects a model-space point to pixels (top-left origin); false when behind the camera.
 bool rs_render_project(const rs_renderer *r, const rs_view *view, const float pos[3], float px[2]);
 
-// Makeup layer records (rs_makeup_gpu, 12 bytes each) for splats [first, first + count).
+// Makeup layer records (rs_makeup_gpu, 12 bytes each) for splats [first, first + count). The next frame
+// of an unchanged view redraws only the attribute and composite passes inside the screen rectangle these
+// splats cover (the result equals a full frame's); anything else (view, environment, makeup uniforms)
+// makes it a full frame.
 rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count, const void *records,
                                   rs_error *err);
 
@@ -182,6 +185,11 @@ rs_render_stats rs_render_get_stats(const rs_renderer *r);
 // environment lights the front of the face about equally (render_env.c).
 rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err);
 bool rs_render_has_env(const rs_renderer *r);
+
+// The next frame is drawn in full (tests of incremental frames; nothing else needs it).
+void rs_render_invalidate(rs_renderer *r);
+// Frames drawn incrementally so far (a makeup change of an unchanged view).
+uint32_t rs_render_incremental_frames(const rs_renderer *r);
 
 // Splats the main passes would draw for this view: the max_splats cap, and in the mobile pipeline the
 // LOD prefix chosen by lod_density from the face's screen area (cheap: a few thousand dot products).

@@ -96,6 +96,7 @@ static float front_irradiance(const rs_env *env)
 
 rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
 {
+    r->inc_valid = false;
     if (r->env_tex) glDeleteTextures(1, &r->env_tex);
     r->env_tex = 0;
     memset(&r->env, 0, sizeof r->env);

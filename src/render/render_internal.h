@@ -168,6 +168,7 @@ struct rs_renderer {
     // ID buffer, re-rendered only when the view changes.
     int pw, ph;
     GLuint pick_tex, pick_depth, fbo_pick;
+    uint32_t *pick_ids;         // the ID buffer read back once per view (rows bottom-first): picks are lookups
     rs_view pick_view;
     bool pick_valid;
 
@@ -175,6 +176,17 @@ struct rs_renderer {
 
     rs_render_env env;          // render_env.c
     GLuint env_tex, lut_tex;
+
+    // Incremental frames (render.c): the last full frame's view and what it drew; makeup uploads since
+    // then mark the screen rectangle their splats cover, and the next frame of the same view re-runs
+    // only stages 3 and 5 inside it (D does not depend on albedo or finish: F = A (D + S)).
+    bool inc_valid;
+    rs_view inc_view;
+    rs_camera inc_cam;
+    uint32_t inc_count;
+    float inc_radius;           // the frame's largest drawn splat reach, model units
+    float dirty[4];             // x0, y0, x1, y1 in target pixels (GL, bottom-left origin); x0 > x1: none
+    uint32_t inc_frames;        // incremental frames drawn (stats, tests)
 
     // Mobile profile cache, one per K (a fit takes milliseconds to tens of milliseconds).
     rs_profile fit[RS_PROFILE_FIT_MAX + 1];

@@ -1,10 +1,12 @@
 // render_pick.c — the ID buffer for painting (paper §3.1: "the 2D cursor becomes a 3D point by reading the
 // splat index stored in an FBO"): the visibility pass's ray-disk shader, without the push, writing
 // index + 1 into an R32UI target (0 = background). Rendered on demand and cached while the view's
-// geometry (size, camera, LOD, primitive) stays the same, so a stroke of many stamps renders it once.
+// geometry (size, camera, LOD, primitive) stays the same, so a stroke of many stamps renders it once;
+// read back whole at that time, so each pick is a lookup in memory, not a pipeline stall.
 #include "render/render_internal.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define CULL_COS -0.25f
@@ -17,6 +19,8 @@ void rs_render_pick_release(rs_renderer *r)
     r->fbo_pick = r->pick_tex = r->pick_depth = 0;
     r->pw = r->ph = 0;
     r->pick_valid = false;
+    free(r->pick_ids);
+    r->pick_ids = NULL;
 }
 
 static bool same_geometry(const rs_view *a, const rs_view *b)
@@ -76,11 +80,24 @@ static bool render_ids(rs_renderer *r, const rs_view *view)
     glDisable(GL_DEPTH_TEST);
     glBindVertexArray(0);
     glUseProgram(0);
+    // Integer targets read back as RGBA_INTEGER (the one format ES 3 guarantees); keep the red channel.
+    size_t n = (size_t)f.cam.width * (size_t)f.cam.height;
+    uint32_t *rgba = rs_alloc_array(n, 4 * sizeof(uint32_t));
+    uint32_t *ids = realloc(r->pick_ids, n * sizeof *ids);
+    bool ok = rgba && ids;
+    if (ids) r->pick_ids = ids;
+    if (ok) {
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        glReadPixels(0, 0, f.cam.width, f.cam.height, GL_RGBA_INTEGER, GL_UNSIGNED_INT, rgba);
+        ok = glGetError() == GL_NO_ERROR;
+        for (size_t i = 0; ok && i < n; i++) ids[i] = rgba[4 * i];
+    }
+    free(rgba);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glViewport(saved_viewport[0], saved_viewport[1], saved_viewport[2], saved_viewport[3]);
     r->pick_view = *view;
-    r->pick_valid = true;
-    return true;
+    r->pick_valid = ok;
+    return ok;
 }
 
 // Where the eye ray through pixel (x, y) meets splat i's plane: the stamp centre must be the surface
@@ -122,13 +139,9 @@ bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px,
     if (!r->pick_valid || !same_geometry(&r->pick_view, view))
         if (!render_ids(r, view)) return false;
     int x = (int)x_px, y = view->height - 1 - (int)y_px;
-    GLuint id[4] = {0, 0, 0, 0};
-    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_pick);
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(x, y, 1, 1, GL_RGBA_INTEGER, GL_UNSIGNED_INT, id);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (glGetError() != GL_NO_ERROR || id[0] == 0 || id[0] > r->cloud->hdr.count) return false;
-    *splat_index = id[0] - 1;
+    uint32_t id = r->pick_ids[(size_t)y * (size_t)view->width + (size_t)x];
+    if (id == 0 || id > r->cloud->hdr.count) return false;
+    *splat_index = id - 1;
     if (hit) hit_point(r, view, x_px + 0.5f, y_px + 0.5f, *splat_index, hit);
     return true;
 }
