@@ -542,9 +542,8 @@ static void feed_paint(vw_viewer *v, rs_input_type type, int id, float x, float 
     if (res.pan_dx_px != 0 || res.pan_dy_px != 0) pan(v, res.pan_dx_px, res.pan_dy_px);
     if (res.zoom != 1.0f && res.zoom > 0) zoom_at(v, res.zoom, res.zoom_cx_px, res.zoom_cy_px);
     upload(v, res.dirty);
-    if (res.stroke_end && v->rec) {
-        if (rs_strokes_save(v->rec, v->cli->record, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
-    }
+    // The recording is rewritten (and fsynced) once the picture settles, not inside the stroke's frame.
+    if (res.stroke_end && v->rec) v->rec_unsaved = true;
     // Navigation coarsens the picture while it moves; painting does not: the view stays, so the renderer
     // redraws only what the stamps touched (incremental frames) at full quality.
     bool navigated = res.orbit_dx_px != 0 || res.orbit_dy_px != 0 || res.pan_dx_px != 0 || res.pan_dy_px != 0 ||
@@ -941,6 +940,11 @@ static rs_result run(vw_viewer *v, rs_error *err)
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
         }
         frame(v, step.screenshot, step.rect, err);
+        if (v->rec_unsaved && at_full_quality(v)) {
+            rs_error e2 = {0};
+            v->rec_unsaved = false;
+            if (rs_strokes_save(v->rec, v->cli->record, &e2) != RS_OK) vw_toast(v, true, "%s", e2.msg);
+        }
     }
     return RS_OK;
 }

@@ -223,6 +223,7 @@ typedef struct vw_viewer {
 
     // Files.
     rs_strokes *rec;
+    bool rec_unsaved;           // strokes recorded since the file was last written (saved when idle)
     char look_path[512];
     int shot_counter;
     char toast[256];
