@@ -310,8 +310,11 @@ static void test_k3_fit_matches_six_gaussians_at_a_shadow_edge(void)
     if (ok) {
         RS_CHECK(drawn == n, "mobile drew %u splats, not all %u", drawn, n);
         edge_error e3 = shadow_edge_error(&shadow, &ref, &k3, 4), e2 = shadow_edge_error(&shadow, &ref, &k2, 4);
-        // (measured on llvmpipe: K = 3 mean 0.98, 99th percentile 12; K = 2 mean 1.45, 16)
-        bool good = RS_CHECK(e3.n > 2000 && e3.mean <= 1.25 && e3.p99 <= 14, "K = 3 vs six Gaussians along the "
+        // (measured on llvmpipe: K = 3 mean 1.55, 99th percentile 13. With the normal-offset shadow bias it
+        // was 0.98 / 12; the receiver-plane bias of issue 12 draws cast-shadow edges where they belong and
+        // fades the terminator's attached shadow, both sharper than before, so the band around them holds
+        // more of the crease pixels where the two profiles differ most.)
+        bool good = RS_CHECK(e3.n > 2000 && e3.mean <= 1.75 && e3.p99 <= 15, "K = 3 vs six Gaussians along the "
                              "shadow edges (%d px): mean error %.2f, 99th percentile %d linear 8-bit steps", e3.n,
                              e3.mean, e3.p99);
         good = RS_CHECK(e3.mean < e2.mean, "K = 3 (mean error %.2f) not closer than K = 2 (%.2f)", e3.mean, e2.mean) &&
