@@ -119,12 +119,16 @@ $(BUILD)/rouge-pack: $(BUILD)/obj/tools/rouge_pack.o $(BUILD)/libpack.a $(BUILD)
 	$(CC) $(CFLAGS) $< $(BUILD)/libpack.a $(PACK_LIBS) $(LIBS) $(LDFLAGS) -o $@
 
 # rouge-env (tools-time only) reads OpenEXR through the C++ library (tools/env/exr_read.cpp: OpenEXR 3.1's
-# C core cannot decode DWA, which blender-data's HDRIs use), so it links with the C++ compiler.
+# C core cannot decode DWA, which blender-data's HDRIs use), so it links with the C++ compiler. env_bake.c
+# (pure C: light, SH, prefiltering) is also linked into test_env_tool.
 CXX ?= c++
+ENV_BAKE_OBJ := $(BUILD)/obj/tools/env/env_bake.o
+ENV_TOOL_OBJ := $(BUILD)/obj/tools/env/rouge_env.o $(ENV_BAKE_OBJ) $(BUILD)/obj/tools/env/env_read.o \
+                $(BUILD)/obj/tools/env/exr_read.o
 $(BUILD)/obj/tools/env/exr_read.o: tools/env/exr_read.cpp tools/env/exr_read.h
 	@mkdir -p $(dir $@)
 	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror $(EXTRA_CFLAGS) $(shell pkg-config --cflags OpenEXR) -c $< -o $@
-$(BUILD)/rouge-env: $(BUILD)/obj/tools/env/rouge_env.o $(BUILD)/obj/tools/env/exr_read.o $(BUILD)/librouge.a
+$(BUILD)/rouge-env: $(ENV_TOOL_OBJ) $(BUILD)/librouge.a
 	$(CXX) $(OPT) -g $(EXTRA_CFLAGS) $^ $(PKG_LIBS) $(shell pkg-config --libs OpenEXR) -lm $(LDFLAGS) -o $@
 
 $(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a
@@ -132,9 +136,11 @@ $(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a
 
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(sort $(wildcard tests/support/*.c)))
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a \
+                  $(ENV_BAKE_OBJ)
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a $(PACK_LIBS)) $(TEST_LIBS) $(LDFLAGS) -o $@
+	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a $(PACK_LIBS)) \
+	    $(if $(filter test_env_tool,$*),$(ENV_BAKE_OBJ)) $(TEST_LIBS) $(LDFLAGS) -o $@
 
 # Regenerates the committed import fixtures that need JPEG encoding (tests/fixtures/import/head/, *.jpg)
 # from ../shared/data (tools/make_import_fixtures.c; the rest come from tests/fixtures/import/make_fixtures.py).

@@ -9,17 +9,19 @@
 #   tools/fuzz/fuzz_strokes.c rs_strokes_parse (src/formats/strokes.c) tests/fixtures/strokes
 #   tools/fuzz/fuzz_look.c   rs_look_parse + apply (src/formats/look.c) tests/fixtures/looks
 #   tools/fuzz/fuzz_convert.c PLY -> convert -> preview -> save/load  tests/fixtures/ply + bad/ply_*
+#   tools/fuzz/fuzz_env.c    rs_env_load_memory (src/formats/env.c)  tests/fixtures/env
+#   tools/fuzz/fuzz_envmap.c rouge-env's .hdr/.exr readers (tools/env/env_read.c, exr_read.cpp) tests/fixtures/env
 # plus, for each, the inputs kept from earlier crashes: tests/fixtures/bad/fuzz/<name>/ (run first, as
 # regression tests; the ordinary test suite also feeds them to the real programs, tests/test_robustness.sh).
 #
-# Environment: FUZZ_SECONDS (default 60 per harness), FUZZ_TARGETS (default "ply rsf strokes look convert"),
+# Environment: FUZZ_SECONDS (default 60 per harness), FUZZ_TARGETS (default "ply rsf strokes look convert env envmap"),
 # FUZZ_DIR (default build/fuzz), FUZZ_JOBS (parallel harness runs, default 1: the machine may be shared).
 # Exit status: 0 no crash, 1 a crash/leak/timeout (the reproducer's path is printed), 2 cannot build.
 # Needs clang with libFuzzer and the sanitizer runtimes (Debian: clang, libclang-rt-14-dev).
 set -u
 cd "$(dirname "$0")/.." || exit 2
 seconds=${FUZZ_SECONDS:-60}
-targets=${FUZZ_TARGETS:-ply rsf strokes look convert}
+targets=${FUZZ_TARGETS:-ply rsf strokes look convert env envmap}
 dir=${FUZZ_DIR:-build/fuzz}
 jobs=${FUZZ_JOBS:-1}
 cc=${FUZZ_CC:-clang}
@@ -49,10 +51,22 @@ make --no-print-directory -s BUILD="$dir/lib" CC="$cc" OPT=-O1 \
 pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm 2>/dev/null)
 for t in $targets; do
     src="tools/fuzz/fuzz_$t.c"
-    [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert)"
+    [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert env envmap)"
+    extra_c="" extra_obj="" link="$cc"
+    if [ "$t" = envmap ]; then
+        # rouge-env's readers: C parts compiled in, the OpenEXR C++ reader with clang++, linked as C++.
+        cxx=${FUZZ_CXX:-clang++}
+        # shellcheck disable=SC2046
+        "$cxx" -std=c++17 -g -O1 -Wall -Wextra -Werror -fsanitize=fuzzer-no-link $san $(pkg-config --cflags OpenEXR) \
+            -c tools/env/exr_read.cpp -o "$dir/exr_read.o" 2>"$dir/fuzz_$t.log" ||
+            { cat "$dir/fuzz_$t.log" >&2; die "cannot build tools/env/exr_read.cpp"; }
+        extra_c="tools/env/env_read.c tools/env/env_bake.c"
+        extra_obj="$dir/exr_read.o $(pkg-config --libs OpenEXR)"
+        link="$cxx -x c"
+    fi
     # shellcheck disable=SC2086
-    "$cc" -std=c11 -g -O1 -Wall -Wextra -Werror -fsanitize=fuzzer $san -Isrc -Itools "$src" \
-        "$dir/lib/libpack.a" "$dir/lib/librouge.a" $pkgs -lm -o "$dir/fuzz_$t" 2>"$dir/fuzz_$t.log" ||
+    $link -std=c11 -g -O1 -Wall -Wextra -Werror -fsanitize=fuzzer $san -Isrc -Itools $(pkg-config --cflags stb) \
+        "$src" $extra_c -x none $extra_obj "$dir/lib/libpack.a" "$dir/lib/librouge.a" $pkgs -lm -o "$dir/fuzz_$t" 2>"$dir/fuzz_$t.log" ||
         { cat "$dir/fuzz_$t.log" >&2; die "cannot build $src"; }
 done
 
@@ -63,6 +77,7 @@ seeds_of() {
         strokes) echo tests/fixtures/strokes ;;
         look) echo tests/fixtures/looks ;;
         convert) echo tests/fixtures/ply ;;
+        env | envmap) echo tests/fixtures/env ;;
     esac
 }
 

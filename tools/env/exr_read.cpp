@@ -4,39 +4,89 @@
 // exr_read.h; exceptions become an error message.
 #include "exr_read.h"
 
+#include <Iex.h>
 #include <ImfArray.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
 #include <ImfRgbaFile.h>
 
-#include <cmath>
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstdint>
+#include <cstring>
 #include <exception>
 
-extern "C" int rs_exr_read(const char *path, long long max_side, int *out_w, int *out_h, float **out_rgb, char *msg,
-                           size_t msg_cap)
+namespace {
+
+// The file's bytes as an input stream: every read is bounds-checked, so a truncated file is an exception,
+// never a read past the buffer.
+class MemoryStream : public Imf::IStream {
+  public:
+    MemoryStream(const char *name, const char *data, uint64_t len) : Imf::IStream(name), data_(data), len_(len) {}
+    bool read(char c[], int n) override
+    {
+        if (n < 0 || pos_ > len_ || (uint64_t)n > len_ - pos_) throw Iex::InputExc("the file ends early (truncated)");
+        std::memcpy(c, data_ + pos_, (size_t)n);
+        pos_ += (uint64_t)n;
+        return pos_ < len_;
+    }
+    uint64_t tellg() override { return pos_; }
+    void seekg(uint64_t pos) override { pos_ = pos; }
+
+  private:
+    const char *data_;
+    uint64_t len_, pos_ = 0;
+};
+
+// Rows decoded per readPixels call: the staging buffer stays small whatever the image's height.
+const long long band_rows = 64;
+
+}  // namespace
+
+extern "C" int rs_exr_read_memory(const void *data, size_t len, const char *name, long long max_width, int *out_w, int *out_h,
+                                  float **out_rgb, char *msg, size_t msg_cap)
 {
     *out_rgb = nullptr;
+    float *rgb = nullptr;
     try {
-        Imf::RgbaInputFile in(path);
+        // The library's own sanity check refuses larger data windows and tiles while it reads the header,
+        // before it sizes its chunk tables from them (a 100-byte file may claim 2^31 rows).
+        int cap = (int)std::min(max_width, (long long)INT32_MAX);
+        Imf::Header::setMaxImageSize(cap, cap);
+        Imf::Header::setMaxTileSize(cap, cap);
+        MemoryStream stream(name, static_cast<const char *>(data), len);
+        // One thread: the tool is not time-critical and the fuzz harness wants determinism.
+        Imf::RgbaInputFile in(stream, 0);
         Imath::Box2i dw = in.dataWindow();
         long long w = (long long)dw.max.x - dw.min.x + 1, h = (long long)dw.max.y - dw.min.y + 1;
-        *out_w = (int)std::min(w, (long long)INT32_MAX), *out_h = (int)std::min(h, (long long)INT32_MAX);
-        // The caller decides whether the size is acceptable; nothing is allocated for a refused one.
-        if (w <= 0 || h <= 0 || w > max_side || h > max_side) return 2;
-        Imf::Array2D<Imf::Rgba> px(h, w);
-        in.setFrameBuffer(&px[0][0] - dw.min.x - dw.min.y * w, 1, (size_t)w);
-        in.readPixels(dw.min.y, dw.max.y);
-        float *rgb = (float *)std::malloc((size_t)w * (size_t)h * 3 * sizeof(float));
+        *out_w = (int)std::max(std::min(w, (long long)INT32_MAX), (long long)INT32_MIN);
+        *out_h = (int)std::max(std::min(h, (long long)INT32_MAX), (long long)INT32_MIN);
+        // The caller's limits hold before any pixel memory is allocated.
+        if (w <= 0 || h <= 0 || w > max_width || w != 2 * h) return 2;
+        rgb = (float *)std::malloc((size_t)w * (size_t)h * 3 * sizeof(float));
+        Imf::Array2D<Imf::Rgba> band(std::min(band_rows, h), w);
         if (!rgb) {
-            std::snprintf(msg, msg_cap, "out of memory");
+            std::snprintf(msg, msg_cap, "out of memory for %lldx%lld pixels", w, h);
             return 1;
         }
-        for (long long y = 0; y < h; y++)
-            for (long long x = 0; x < w; x++) {
-                const Imf::Rgba &p = px[y][x];
-                float *o = rgb + ((size_t)y * (size_t)w + (size_t)x) * 3;
-                o[0] = p.r, o[1] = p.g, o[2] = p.b;
-            }
+        for (long long y0 = 0; y0 < h; y0 += band_rows) {
+            long long rows = std::min(band_rows, h - y0);
+            // The frame buffer is addressed by absolute pixel coordinates: shift the base so that
+            // (dw.min.x, dw.min.y + y0) lands on band[0][0].
+            // (integer arithmetic: the shifted pointer may lie far outside the buffer, as the API intends).
+            uintptr_t shift = ((uintptr_t)(intptr_t)dw.min.x + (uintptr_t)(intptr_t)(dw.min.y + y0) * (uintptr_t)w) *
+                              sizeof(Imf::Rgba);
+            Imf::Rgba *base = reinterpret_cast<Imf::Rgba *>(reinterpret_cast<uintptr_t>(&band[0][0]) - shift);
+            in.setFrameBuffer(base, 1, (size_t)w);
+            in.readPixels((int)(dw.min.y + y0), (int)(dw.min.y + y0 + rows - 1));
+            for (long long y = 0; y < rows; y++)
+                for (long long x = 0; x < w; x++) {
+                    const Imf::Rgba &p = band[y][x];
+                    float *o = rgb + ((size_t)(y0 + y) * (size_t)w + (size_t)x) * 3;
+                    o[0] = p.r, o[1] = p.g, o[2] = p.b;
+                }
+        }
         *out_rgb = rgb;
         return 0;
     } catch (const std::exception &e) {
@@ -44,5 +94,6 @@ extern "C" int rs_exr_read(const char *path, long long max_side, int *out_w, int
     } catch (...) {
         std::snprintf(msg, msg_cap, "unknown OpenEXR error");
     }
+    std::free(rgb);
     return 1;
 }

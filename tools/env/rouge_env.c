@@ -3,427 +3,246 @@
 // prefiltered for a ladder of Beckmann roughnesses. Tools-time only: the renderer reads the .rse and never
 // needs OpenEXR.
 //
-//   rouge-env studio.exr -o assets/env/studio.rse --name studio [--key-yaw -35] [--notes TEXT]
+//   rouge-env studio.exr -o assets/env/studio.rse --name studio [--key-yaw -35] [--notes TEXT] [--preview PNG]
 //
-// Steps (each a function below): read -> find the brightest compact region -> take it out as a light
-// (its excess over the surrounding level, so nothing is counted twice) -> turn the map about up so the
-// light sits at --key-yaw -> SH9 of the remainder's irradiance -> prefilter the remainder.
+// Reading: env_read.c (+ exr_read.cpp); the work: env_bake.c; here: options, notes, the preview.
 #define _POSIX_C_SOURCE 200809L
 #include "core/core.h"
 #include "core/image.h"
 #include "formats/env.h"
 
-#include "env/exr_read.h"
+#include "env/env_bake.h"
+#include "env/env_read.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define STB_IMAGE_IMPLEMENTATION
-#define STBI_ONLY_HDR
-#define STBI_NO_STDIO
-#define STBI_FAILURE_USERMSG
-#include <stb/stb_image.h>
-
 #define PI_F 3.14159265358979f
-#define MAX_SIDE 16384              // input width at most (height = width / 2)
-#define MAX_FILE_BYTES (1u << 30)
-#define OUT_WIDTH 256               // level 0 of the prefiltered chain
-#define LEVELS 6
-static const float level_m[LEVELS] = {0.06f, 0.12f, 0.22f, 0.38f, 0.6f, 1.0f};
+#define ROUGE_ENV_VERSION "2"  // bumped when the bake's results change (notes record it)
 
-typedef struct map {
-    int w, h;
-    float *rgb;  // w * h * 3, rows top (up) first
-} map;
+// ---- preview ----
 
-static void map_free(map *m) { free(m->rgb), m->rgb = NULL; }
-
-static rs_result map_alloc(map *m, int w, int h, rs_error *err)
+// Bilinear radiance of level k towards d (u wraps, v clamps), as the GPU samples it.
+static void sample_level(const rs_env_level *l, const float d[3], float out[3])
 {
-    m->w = w, m->h = h;
-    m->rgb = rs_alloc_array((size_t)w * (size_t)h * 3, sizeof(float));
-    return m->rgb ? RS_OK : rs_fail(err, RS_ERR_NOMEM, "out of memory (%dx%d map)", w, h);
+    float uv[2];
+    rs_env_dir_to_uv(d, uv);
+    float fx = uv[0] * (float)l->width - 0.5f, fy = uv[1] * (float)l->height - 0.5f;
+    int x0 = (int)floorf(fx), y0 = (int)floorf(fy);
+    float tx = fx - (float)x0, ty = fy - (float)y0;
+    out[0] = out[1] = out[2] = 0;
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int x = ((x0 + i) % l->width + l->width) % l->width, y = RS_CLAMP(y0 + j, 0, l->height - 1);
+            float c[3], wgt = (i ? tx : 1 - tx) * (j ? ty : 1 - ty);
+            rs_rgb9e5_unpack(l->rgb9e5[(size_t)y * (size_t)l->width + (size_t)x], c);
+            for (int k = 0; k < 3; k++) out[k] += wgt * c[k];
+        }
 }
 
-static float lum(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
-
-// Texel centre direction and solid angle of row j (equirect: dw = (2 pi / w)(pi / h) sin theta).
-static void texel_dir(const map *m, int i, int j, float d[3])
+static void put(rs_image *img, int x, int y, const float c[3], float exposure)
 {
-    float uv[2] = {((float)i + 0.5f) / (float)m->w, ((float)j + 0.5f) / (float)m->h};
-    rs_env_uv_to_dir(uv, d);
-}
-static float texel_sr(const map *m, int j)
-{
-    return (2.0f * PI_F / (float)m->w) * (PI_F / (float)m->h) * sinf(PI_F * ((float)j + 0.5f) / (float)m->h);
+    uint8_t *p = img->pixels + ((size_t)y * (size_t)img->width + (size_t)x) * 3;
+    for (int k = 0; k < 3; k++) {
+        float v = RS_MAX(c[k], 0.0f) * exposure;
+        p[k] = (uint8_t)lrintf(rs_linear_to_srgb(v / (1.0f + v)) * 255.0f);
+    }
 }
 
-// --- reading ----------------------------------------------------------------------------------------------
-
-static rs_result check_size(const char *path, long long w, long long h, rs_error *err)
+// Top: the work map without its light (the region keeps the surrounding level), outlined in red, the
+// light's direction marked by a cross. Bottom, spheres seen from the front: white Lambert under SH + light,
+// under SH alone, and mirror-like reflections of levels 0 (m 0.06) and 3 (m 0.38) plus the light's
+// highlight. One exposure for all: the brightest Lambert normal reads as 0.6.
+static rs_result write_preview(const rs_env *e, const rs_envmap *work, const uint8_t *mask, const char *path,
+                               rs_error *err)
 {
-    if (w <= 0 || h <= 0 || w > MAX_SIDE || h > MAX_SIDE / 2)
-        return rs_fail(err, RS_ERR_LIMIT, "%s: %lldx%lld: an environment is at most %dx%d", path, w, h, MAX_SIDE,
-                       MAX_SIDE / 2);
-    if (w != 2 * h || w < 16)
-        return rs_fail(err, RS_ERR_FORMAT, "%s: %lldx%lld is not a latitude-longitude map (width = 2 x height, >= 16)",
-                       path, w, h);
-    return RS_OK;
-}
-
-static rs_result read_hdr(const char *path, const void *data, size_t len, map *out, rs_error *err)
-{
-    int w = 0, h = 0, comp = 0;
-    if (len > (size_t)INT32_MAX) return rs_fail(err, RS_ERR_LIMIT, "%s: too large", path);
-    // Size first: a header may claim any size, and stb would allocate it.
-    if (!stbi_info_from_memory(data, (int)len, &w, &h, &comp))
-        return rs_fail(err, RS_ERR_FORMAT, "%s: not a readable Radiance .hdr (%s)", path, stbi_failure_reason());
-    rs_result r = check_size(path, w, h, err);
-    if (r != RS_OK) return r;
-    float *px = stbi_loadf_from_memory(data, (int)len, &w, &h, &comp, 3);
-    if (!px) return rs_fail(err, RS_ERR_FORMAT, "%s: cannot decode (%s)", path, stbi_failure_reason());
-    out->w = w, out->h = h, out->rgb = px;
-    return RS_OK;
-}
-
-// OpenEXR through the C++ library (exr_read.cpp: the 3.1 C core cannot decode DWA, which Blender's HDRIs
-// use).
-static rs_result read_exr(const char *path, map *out, rs_error *err)
-{
-    char msg[256] = "";
-    int w = 0, h = 0;
-    float *rgb = NULL;
-    int rc = rs_exr_read(path, MAX_SIDE, &w, &h, &rgb, msg, sizeof msg);
-    if (rc == 2) return check_size(path, w, h, err);
-    if (rc != 0) return rs_fail(err, RS_ERR_FORMAT, "%s: OpenEXR: %.200s", path, msg);
-    rs_result r = check_size(path, w, h, err);
+    enum { W = 512, H = 256, S = 128 };
+    rs_envmap small = {0};
+    rs_image img = {0};
+    rs_result r = rs_envmap_resample(work, W, &small, err);
+    if (r == RS_OK) r = rs_image_create(W, H + S, 3, &img, err);
     if (r != RS_OK) {
-        free(rgb);
+        rs_envmap_free(&small);
         return r;
     }
-    out->w = w, out->h = h, out->rgb = rgb;
-    return RS_OK;
-}
-
-static rs_result read_map(const char *path, map *out, rs_error *err)
-{
-    void *data = NULL;
-    size_t len = 0;
-    rs_result r = rs_file_read_all(path, MAX_FILE_BYTES, &data, &len, err);
-    if (r != RS_OK) return r;
-    static const uint8_t exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
-    if (len >= 4 && memcmp(data, exr_magic, 4) == 0) r = read_exr(path, out, err);
-    else if (len >= 2 && memcmp(data, "#?", 2) == 0) r = read_hdr(path, data, len, out, err);
-    else r = rs_fail(err, RS_ERR_FORMAT, "%s: neither OpenEXR nor Radiance .hdr", path);
-    free(data);
-    if (r != RS_OK) return r;
-    // Negative, NaN or infinite radiance is a broken capture; keep what is usable.
-    size_t n = (size_t)out->w * (size_t)out->h * 3;
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(out->rgb[i]) || out->rgb[i] < 0.0f) out->rgb[i] = 0.0f;
-        else if (out->rgb[i] > 65000.0f) out->rgb[i] = 65000.0f;
-    return RS_OK;
-}
-
-// --- resampling -------------------------------------------------------------------------------------------
-
-// Box-filtered copy at w x h (w <= src.w): each source texel adds into the target texel it falls in,
-// weighted by its solid angle.
-static rs_result downsample(const map *src, int w, int h, map *out, rs_error *err)
-{
-    rs_result r = map_alloc(out, w, h, err);
-    if (r != RS_OK) return r;
-    float *wsum = calloc((size_t)w * (size_t)h, sizeof(float));
-    if (!wsum) return map_free(out), rs_fail(err, RS_ERR_NOMEM, "out of memory");
-    memset(out->rgb, 0, (size_t)w * (size_t)h * 3 * sizeof(float));
-    for (int j = 0; j < src->h; j++) {
-        int tj = (int)((long long)j * h / src->h);
-        float sr = texel_sr(src, j);
-        for (int i = 0; i < src->w; i++) {
-            int ti = (int)((long long)i * w / src->w);
-            size_t t = (size_t)tj * (size_t)w + (size_t)ti;
-            const float *s = src->rgb + ((size_t)j * (size_t)src->w + (size_t)i) * 3;
-            for (int c = 0; c < 3; c++) out->rgb[t * 3 + c] += s[c] * sr;
-            wsum[t] += sr;
-        }
+    float emax = 1e-6f;
+    for (int t = 0; t < 2000; t++) {
+        float z = 1.0f - 2.0f * ((float)t + 0.5f) / 2000.0f, a = (float)t * 2.39996f, s = sqrtf(1 - z * z);
+        float n[3] = {s * cosf(a), z, s * sinf(a)}, c[3];
+        float nl = RS_MAX(0.0f, n[0] * e->light_dir[0] + n[1] * e->light_dir[1] + n[2] * e->light_dir[2]);
+        rs_env_sh_irradiance(e, n, c);
+        for (int k = 0; k < 3; k++) emax = RS_MAX(emax, c[k] + e->light_color[k] * nl);
     }
-    for (size_t t = 0; t < (size_t)w * (size_t)h; t++)
-        for (int c = 0; c < 3; c++) out->rgb[t * 3 + c] /= RS_MAX(wsum[t], 1e-20f);
-    free(wsum);
-    return RS_OK;
-}
-
-// Turns the map about up by `dphi` radians (a light at phi moves to phi + dphi): a column shift with
-// linear interpolation, wrapping.
-static void rotate_map(map *m, float dphi)
-{
-    float shift = dphi / (2.0f * PI_F) * (float)m->w;
-    float *row = malloc((size_t)m->w * 3 * sizeof(float));
-    if (!row) return;
-    for (int j = 0; j < m->h; j++) {
-        float *r = m->rgb + (size_t)j * (size_t)m->w * 3;
-        memcpy(row, r, (size_t)m->w * 3 * sizeof(float));
-        for (int i = 0; i < m->w; i++) {
-            float x = (float)i - shift;
-            float fl = floorf(x), t = x - fl;
-            int a = (((int)fl % m->w) + m->w) % m->w, b = (a + 1) % m->w;
-            for (int c = 0; c < 3; c++) r[i * 3 + c] = row[a * 3 + c] * (1 - t) + row[b * 3 + c] * t;
+    float exposure = 1.5f / emax;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            // Region border: a region texel of the work map with a neighbour outside.
+            int wi = x * work->w / W, wj = y * work->h / H;
+            bool border = false;
+            if (mask[(size_t)wj * (size_t)work->w + (size_t)wi])
+                for (int dj = -1; dj <= 1; dj++)
+                    for (int di = -1; di <= 1; di++) {
+                        int j = wj + dj * RS_MAX(1, work->h / H), i = (wi + di * RS_MAX(1, work->w / W) + work->w) % work->w;
+                        if (j >= 0 && j < work->h && !mask[(size_t)j * (size_t)work->w + (size_t)i]) border = true;
+                    }
+            static const float red[3] = {1e3f, 0, 0};
+            put(&img, x, y, border ? red : small.rgb + ((size_t)y * W + (size_t)x) * 3, border ? 1.0f : exposure);
         }
+    float uv[2];
+    rs_env_dir_to_uv(e->light_dir, uv);
+    int lx = (int)(uv[0] * W), ly = (int)(uv[1] * H);
+    static const float cyan[3] = {0, 1e3f, 1e3f};
+    for (int k = -6; k <= 6; k++) {
+        if (ly + k >= 0 && ly + k < H) put(&img, (lx + W) % W, ly + k, cyan, 1.0f);
+        put(&img, (lx + k + W) % W, RS_CLAMP(ly, 0, H - 1), cyan, 1.0f);
     }
-    free(row);
-}
-
-// --- the dominant light -----------------------------------------------------------------------------------
-
-typedef struct light {
-    float dir[3], color[3], angle;
-    float solid_angle;
-} light;
-
-// The brightest compact region: the peak of a 64x32 copy (about 6 degrees a texel), then every texel of
-// the full map within 30 degrees of it brighter than a quarter of the peak's mean and than 1/20 of the
-// brightest texel there. Its excess over the
-// level around it (a 10-degree ring outside the region) becomes the light; the texels keep that level.
-static rs_result extract_light(map *m, light *out, rs_error *err)
-{
-    map small = {0};
-    rs_result r = downsample(m, 64, 32, &small, err);
-    if (r != RS_OK) return r;
-    int best = 0;
-    for (int t = 1; t < 64 * 32; t++)
-        if (lum(small.rgb + t * 3) > lum(small.rgb + best * 3)) best = t;
-    float peak[3];
-    texel_dir(&small, best % 64, best / 64, peak);
-    float peak_lum = lum(small.rgb + best * 3);
-    map_free(&small);
-
-    const float cos_reach = cosf(30.0f * PI_F / 180.0f);
-    size_t n = (size_t)m->w * (size_t)m->h;
-    // A sun is far brighter than the sky it sits in, which the coarse copy averages it with: the
-    // threshold also follows the full-resolution peak near the coarse one, so the light is the sun's
-    // disc and not the bright sky around it; a softbox (about uniform) keeps all of its area.
-    float fine_peak = 0.0f;
-    for (int j = 0; j < m->h; j++)
-        for (int i = 0; i < m->w; i++) {
-            float d[3];
-            texel_dir(m, i, j, d);
-            if (d[0] * peak[0] + d[1] * peak[1] + d[2] * peak[2] >= cos_reach)
-                fine_peak = RS_MAX(fine_peak, lum(m->rgb + ((size_t)j * (size_t)m->w + (size_t)i) * 3));
-        }
-    float threshold = RS_MAX(0.25f * peak_lum, 0.05f * fine_peak);
-    uint8_t *in = calloc(n, 1);
-    if (!in) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
-    float max_angle = 0.0f;
-    for (int j = 0; j < m->h; j++)
-        for (int i = 0; i < m->w; i++) {
-            float d[3];
-            texel_dir(m, i, j, d);
-            float c = d[0] * peak[0] + d[1] * peak[1] + d[2] * peak[2];
-            size_t t = (size_t)j * (size_t)m->w + (size_t)i;
-            if (c >= cos_reach && lum(m->rgb + t * 3) > threshold) {
-                in[t] = 1;
-                max_angle = RS_MAX(max_angle, acosf(RS_MIN(c, 1.0f)));
-            }
-        }
-    // The surrounding level: the mean of a ring 10 degrees wide outside the region.
-    float ring_lo = cosf(RS_MIN(max_angle + 10.0f * PI_F / 180.0f, PI_F)), ring[3] = {0, 0, 0}, ring_w = 0;
-    for (int j = 0; j < m->h; j++)
-        for (int i = 0; i < m->w; i++) {
-            size_t t = (size_t)j * (size_t)m->w + (size_t)i;
-            float d[3];
-            texel_dir(m, i, j, d);
-            float c = d[0] * peak[0] + d[1] * peak[1] + d[2] * peak[2];
-            if (in[t] || c < ring_lo) continue;
-            float sr = texel_sr(m, j);
-            for (int k = 0; k < 3; k++) ring[k] += m->rgb[t * 3 + k] * sr;
-            ring_w += sr;
-        }
-    for (int k = 0; k < 3; k++) ring[k] = ring_w > 0 ? ring[k] / ring_w : 0.0f;
-    light L = {{0, 0, 0}, {0, 0, 0}, 0, 0};
-    double dir[3] = {0, 0, 0};
-    for (int j = 0; j < m->h; j++)
-        for (int i = 0; i < m->w; i++) {
-            size_t t = (size_t)j * (size_t)m->w + (size_t)i;
-            if (!in[t]) continue;
-            float d[3], sr = texel_sr(m, j), ex[3];
-            texel_dir(m, i, j, d);
-            for (int k = 0; k < 3; k++) {
-                ex[k] = RS_MAX(m->rgb[t * 3 + k] - ring[k], 0.0f);
-                L.color[k] += ex[k] * sr / PI_F;
-                m->rgb[t * 3 + k] -= ex[k];
-            }
-            float e = lum(ex) * sr;
-            for (int k = 0; k < 3; k++) dir[k] += d[k] * e;
-            L.solid_angle += sr;
-        }
-    free(in);
-    double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
-    if (len <= 0.0) {
-        for (int k = 0; k < 3; k++) L.dir[k] = peak[k];
-    } else {
-        for (int k = 0; k < 3; k++) L.dir[k] = (float)(dir[k] / len);
-    }
-    // The equivalent disc's angular radius (the region's solid angle as a cap).
-    L.angle = acosf(RS_CLAMP(1.0f - L.solid_angle / (2.0f * PI_F), -1.0f, 1.0f));
-    *out = L;
-    return RS_OK;
-}
-
-// --- SH and prefiltering ----------------------------------------------------------------------------------
-
-// Irradiance / pi of the map as SH9: E_lm = A_l L_lm (Ramamoorthi & Hanrahan), A = pi, 2pi/3, pi/4.
-static void project_sh(const map *m, float sh[9][3])
-{
-    double acc[9][3] = {{0}};
-    for (int j = 0; j < m->h; j++) {
-        float sr = texel_sr(m, j);
-        for (int i = 0; i < m->w; i++) {
-            float d[3], y[9];
-            texel_dir(m, i, j, d);
-            rs_env_sh_basis(d, y);
-            const float *c = m->rgb + ((size_t)j * (size_t)m->w + (size_t)i) * 3;
-            for (int k = 0; k < 9; k++)
-                for (int ch = 0; ch < 3; ch++) acc[k][ch] += (double)c[ch] * y[k] * sr;
-        }
-    }
-    static const float a[9] = {1.0f, 2.0f / 3, 2.0f / 3, 2.0f / 3, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};  // A_l / pi
-    for (int k = 0; k < 9; k++)
-        for (int ch = 0; ch < 3; ch++) sh[k][ch] = (float)(acc[k][ch] * a[k]);
-}
-
-static float beckmann(float ndoth, float m)
-{
-    float c2 = ndoth * ndoth, m2 = m * m;
-    return expf((c2 - 1.0f) / (c2 * m2)) / (m2 * c2 * c2);
-}
-
-// Level k: for each output direction R, the source radiance weighted by the Beckmann lobe of roughness m
-// around R with N = V = R: w = P_H(N.h) max(R.l, 0) dw, h = normalize(l + R). The sum is windowed to
-// where the lobe is above ~1e-5 of its peak.
-static rs_result prefilter(const map *src_full, rs_env_level *lvl, float m, rs_error *err)
-{
-    int sw = RS_MIN(src_full->w, RS_MAX(64, 2 * lvl->width));
-    map src = {0};
-    rs_result r = downsample(src_full, sw, sw / 2, &src, err);
-    if (r != RS_OK) return r;
-    float *dirs = malloc((size_t)src.w * (size_t)src.h * 3 * sizeof(float));
-    if (!dirs) return map_free(&src), rs_fail(err, RS_ERR_NOMEM, "out of memory");
-    for (int j = 0; j < src.h; j++)
-        for (int i = 0; i < src.w; i++) texel_dir(&src, i, j, dirs + ((size_t)j * (size_t)src.w + (size_t)i) * 3);
-    // Half-vector angle where exp(-tan^2/m^2) falls below 1e-5: tan = m sqrt(ln 1e5); l turns twice as far.
-    float reach = RS_MIN(2.0f * atanf(m * 3.4f) + 2.0f * PI_F / (float)src.w, PI_F);
-    for (int oj = 0; oj < lvl->height; oj++)
-        for (int oi = 0; oi < lvl->width; oi++) {
-            float uv[2] = {((float)oi + 0.5f) / (float)lvl->width, ((float)oj + 0.5f) / (float)lvl->height}, R[3];
-            rs_env_uv_to_dir(uv, R);
-            float theta0 = PI_F * uv[1];
-            int j0 = RS_MAX(0, (int)floorf((theta0 - reach) / PI_F * (float)src.h));
-            int j1 = RS_MIN(src.h - 1, (int)ceilf((theta0 + reach) / PI_F * (float)src.h));
-            double acc[3] = {0, 0, 0}, wsum = 0;
-            for (int j = j0; j <= j1; j++) {
-                float sr = texel_sr(&src, j);
-                float st = sinf(PI_F * ((float)j + 0.5f) / (float)src.h);
-                int half = src.w / 2;
-                if (st > 1e-3f && reach < PI_F * 0.5f) half = RS_MIN(half, (int)ceilf(reach / st / (2.0f * PI_F) * (float)src.w) + 1);
-                int ic = (int)floorf(uv[0] * (float)src.w);
-                for (int di = -half; di < half + (half == src.w / 2 ? 0 : 1); di++) {
-                    int i = ((ic + di) % src.w + src.w) % src.w;
-                    const float *l = dirs + ((size_t)j * (size_t)src.w + (size_t)i) * 3;
-                    float rl = R[0] * l[0] + R[1] * l[1] + R[2] * l[2];
-                    if (rl <= 0.0f) continue;
-                    float h[3] = {l[0] + R[0], l[1] + R[1], l[2] + R[2]};
-                    float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
-                    float ndoth = (R[0] * h[0] + R[1] * h[1] + R[2] * h[2]) / hl;
-                    float w = beckmann(ndoth, m) * rl * sr;
-                    if (!(w > 0.0f)) continue;
-                    const float *c = src.rgb + ((size_t)j * (size_t)src.w + (size_t)i) * 3;
-                    for (int k = 0; k < 3; k++) acc[k] += c[k] * w;
-                    wsum += w;
+    // Spheres.
+    for (int tile = 0; tile < 4; tile++)
+        for (int y = 0; y < S; y++)
+            for (int x = 0; x < S; x++) {
+                float px = ((float)x + 0.5f) / S * 2 - 1, py = 1 - ((float)y + 0.5f) / S * 2, c[3] = {0, 0, 0};
+                float rr = px * px + py * py;
+                if (rr < 1) {
+                    float n[3] = {px, py, sqrtf(1 - rr)};
+                    float nl = RS_MAX(0.0f, n[0] * e->light_dir[0] + n[1] * e->light_dir[1] + n[2] * e->light_dir[2]);
+                    if (tile < 2) {
+                        rs_env_sh_irradiance(e, n, c);
+                        if (tile == 0)
+                            for (int k = 0; k < 3; k++) c[k] += e->light_color[k] * nl;
+                    } else {
+                        // Reflection of the view (0, 0, 1): R = 2 n.z n - v.
+                        float R[3] = {2 * n[2] * n[0], 2 * n[2] * n[1], 2 * n[2] * n[2] - 1};
+                        int level = tile == 2 ? 0 : 3;
+                        float m = e->level_m[level];
+                        sample_level(&e->levels[level], R, c);
+                        // The light's highlight: its Beckmann lobe, widened by its size (roughness added in
+                        // quadrature with half its radius), a quarter of it as KSK's 1/(h.h) at N = V.
+                        float ml = sqrtf(m * m + 0.25f * e->light_angle * e->light_angle);
+                        float h[3] = {e->light_dir[0], e->light_dir[1], e->light_dir[2] + 1};
+                        float hl = sqrtf(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]);
+                        float nh = (n[0] * h[0] + n[1] * h[1] + n[2] * h[2]) / RS_MAX(hl, 1e-6f);
+                        if (nh > 0 && nl > 0)
+                            for (int k = 0; k < 3; k++) c[k] += e->light_color[k] * rs_env_beckmann(nh, ml) * 0.25f * nl;
+                    }
                 }
+                put(&img, tile * S + x, H + y, c, rr < 1 ? exposure : 0.0f);
             }
-            float out[3];
-            for (int k = 0; k < 3; k++) out[k] = wsum > 0 ? (float)(acc[k] / wsum) : 0.0f;
-            lvl->rgb9e5[(size_t)oj * (size_t)lvl->width + (size_t)oi] = rs_rgb9e5_pack(out);
-        }
-    free(dirs);
-    map_free(&src);
-    return RS_OK;
-}
-
-// --- preview ----------------------------------------------------------------------------------------------
-
-// Level 0 (with the light added back as a disc) tone mapped, for a person to check the light was found.
-static rs_result write_preview(const rs_env *e, const char *path, rs_error *err)
-{
-    const rs_env_level *l = &e->levels[0];
-    rs_image img = {0};
-    rs_result r = rs_image_create(l->width, l->height, 4, &img, err);
-    if (r != RS_OK) return r;
-    float cos_light = cosf(RS_MAX(e->light_angle, 0.02f));
-    float omega = 2.0f * PI_F * (1.0f - cos_light);
-    for (int j = 0; j < l->height; j++)
-        for (int i = 0; i < l->width; i++) {
-            float c[3], d[3], uv[2] = {((float)i + 0.5f) / (float)l->width, ((float)j + 0.5f) / (float)l->height};
-            rs_rgb9e5_unpack(l->rgb9e5[(size_t)j * (size_t)l->width + (size_t)i], c);
-            rs_env_uv_to_dir(uv, d);
-            if (d[0] * e->light_dir[0] + d[1] * e->light_dir[1] + d[2] * e->light_dir[2] >= cos_light)
-                for (int k = 0; k < 3; k++) c[k] += e->light_color[k] * PI_F / omega;
-            uint8_t *p = img.pixels + ((size_t)j * (size_t)l->width + (size_t)i) * 4;
-            for (int k = 0; k < 3; k++) p[k] = (uint8_t)lrintf(rs_linear_to_srgb(c[k] / (1.0f + c[k])) * 255.0f);
-            p[3] = 255;
-        }
     r = rs_image_write_png(path, &img, err);
     rs_image_free(&img);
+    rs_envmap_free(&small);
     return r;
 }
 
-// --- main -------------------------------------------------------------------------------------------------
+// ---- main ----
 
 static int usage(const char *msg)
 {
     if (msg) {
-        fprintf(stderr, "rouge-env: %s (see --help)\n", msg);
+        fprintf(stderr, "rouge-env: %s (rouge-env --help)\n", msg);
         return 2;
     }
-    fprintf(stdout,
-            "usage: rouge-env IN.exr|IN.hdr -o OUT.rse --name NAME [--key-yaw DEG] [--notes TEXT] [--preview PNG]\n"
-            "  Turns a latitude-longitude HDR capture (width = 2 x height, OpenEXR scanline R,G,B or Radiance\n"
-            "  .hdr) into a rouge lighting environment: the brightest compact region becomes the key light\n"
-            "  (turned to --key-yaw, default -35: front-left, like the paper's lamp), the rest SH irradiance\n"
-            "  and radiance prefiltered for roughness %.2f..%.2f. NAME: a-z 0-9 _ -. --preview writes the\n"
-            "  map with the light as a PNG to check it.\n",
-            level_m[0], level_m[LEVELS - 1]);
+    printf("usage: rouge-env IN.exr|IN.hdr -o OUT.rse --name NAME [--key-yaw DEG] [--light-near U,V] [--notes TEXT]\n"
+           "                 [--preview PNG]\n"
+           "       rouge-env --info FILE.rse\n"
+           "  Turns a latitude-longitude HDR capture (width = 2 x height, %d..%d wide; OpenEXR, any compression,\n"
+           "  or Radiance .hdr) into a rouge lighting environment: the most powerful compact bright region (a\n"
+           "  softbox, the sun, a window) becomes the key light, turned to yaw --key-yaw (default -35: front-left\n"
+           "  in a frontal view, like the paper's lamp); the rest becomes SH9 irradiance and radiance\n"
+           "  prefiltered for Beckmann roughness %.2f..%.2f (%d levels from %dx%d, RGB9E5).\n"
+           "  --light-near U,V: take the light near this point of the source image (fractions of its width and\n"
+           "  height) instead of the brightest region, e.g. a window rather than a brighter small lamp.\n"
+           "  NAME: 1..31 of a-z 0-9 _ - (what --env takes). --notes: source, author, licence (kept in the file).\n"
+           "  --preview: a PNG of the map without its light (region outlined red, direction marked) and spheres\n"
+           "  lit by it, to check what was found. --info: what a .rse file holds (and whether it loads).\n",
+           RS_ENVMAP_MIN_WIDTH, RS_ENVMAP_MAX_WIDTH, (double)rs_env_bake_level_m[0],
+           (double)rs_env_bake_level_m[RS_ENV_BAKE_LEVELS - 1], RS_ENV_BAKE_LEVELS, RS_ENV_BAKE_WIDTH,
+           RS_ENV_BAKE_WIDTH / 2);
     return 0;
+}
+
+// --info: what a .rse holds, through the run-time loader (so it also checks a file).
+static int info(const char *path)
+{
+    rs_env *e = NULL;
+    rs_error err = {0};
+    if (rs_env_load(path, &e, &err) != RS_OK) {
+        fprintf(stderr, "rouge-env: %s\n", err.msg);
+        return 1;
+    }
+    char notes[RS_ENV_MAX_NOTES * 4];
+    rs_text_sanitize(notes, sizeof notes, e->notes, strlen(e->notes));
+    float up[3] = {0, 1, 0}, amb[3];
+    rs_env_sh_irradiance(e, up, amb);
+    printf("name: %s\nlevels: %d, level 0 %dx%d, m =", e->name, e->level_count, e->levels[0].width,
+           e->levels[0].height);
+    for (int k = 0; k < e->level_count; k++) printf(" %g", (double)e->level_m[k]);
+    printf("\nlight: yaw %.1f pitch %.1f deg, radius %.2f deg, colour %.4g %.4g %.4g\n"
+           "SH irradiance from above: %.4g %.4g %.4g\nnotes: %s\n",
+           (double)(atan2f(e->light_dir[0], e->light_dir[2]) * 180.0f / PI_F),
+           (double)(asinf(RS_CLAMP(e->light_dir[1], -1.0f, 1.0f)) * 180.0f / PI_F),
+           (double)(e->light_angle * 180.0f / PI_F), (double)e->light_color[0], (double)e->light_color[1],
+           (double)e->light_color[2], (double)amb[0], (double)amb[1], (double)amb[2], notes);
+    rs_env_destroy(e);
+    return 0;
+}
+
+static bool valid_name(const char *s)
+{
+    size_t n = strlen(s);
+    if (n == 0 || n > 31) return false;
+    for (; *s; s++)
+        if (!((*s >= 'a' && *s <= 'z') || (*s >= '0' && *s <= '9') || *s == '_' || *s == '-')) return false;
+    return true;
 }
 
 int main(int argc, char **argv)
 {
     const char *in = NULL, *out = NULL, *name = NULL, *notes = "", *preview = NULL;
     float key_yaw = -35.0f;
+    rs_env_bake_desc desc = {0};
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "-h") || !strcmp(a, "--help")) return usage(NULL);
-        bool has = i + 1 < argc;
+        if (!strcmp(a, "--info")) {
+            if (i + 1 >= argc || argc != 3) return usage("--info FILE.rse takes nothing else");
+            return info(argv[i + 1]);
+        }
         if (!strcmp(a, "-o") || !strcmp(a, "--name") || !strcmp(a, "--key-yaw") || !strcmp(a, "--notes") ||
-            !strcmp(a, "--preview")) {
-            if (!has) return usage("an option needs a value");
+            !strcmp(a, "--preview") || !strcmp(a, "--light-near")) {
+            if (i + 1 >= argc) {
+                fprintf(stderr, "rouge-env: %s needs a value (rouge-env --help)\n", a);
+                return 2;
+            }
             const char *v = argv[++i];
             if (!strcmp(a, "-o")) out = v;
             else if (!strcmp(a, "--name")) name = v;
             else if (!strcmp(a, "--notes")) notes = v;
             else if (!strcmp(a, "--preview")) preview = v;
-            else {
+            else if (!strcmp(a, "--light-near")) {
+                char *end;
+                errno = 0;
+                desc.light_near_uv[0] = strtof(v, &end);
+                bool ok = end != v && *end == ',' && errno == 0;
+                const char *v2 = end + 1;
+                if (ok) desc.light_near_uv[1] = strtof(v2, &end);
+                ok = ok && end != v2 && !*end && errno == 0;
+                for (int k = 0; k < 2 && ok; k++) ok = desc.light_near_uv[k] >= 0.0f && desc.light_near_uv[k] <= 1.0f;
+                if (!ok) return usage("--light-near: U,V of the source image, each 0..1 (e.g. 0.55,0.4)");
+                desc.light_near = true;
+            } else {
                 char *end;
                 errno = 0;
                 key_yaw = strtof(v, &end);
                 if (end == v || *end || errno || !isfinite(key_yaw) || fabsf(key_yaw) > 360.0f)
                     return usage("--key-yaw: a number of degrees in -360..360");
             }
-        } else if (a[0] == '-') {
-            fprintf(stderr, "rouge-env: unknown option '%s' (see --help)\n", a);
-            return 2;
+        } else if (a[0] == '-' && a[1]) {
+            char msg[160];
+            snprintf(msg, sizeof msg, "unknown option '%.100s'", a);
+            return usage(msg);
         } else if (!in) {
             in = a;
         } else {
@@ -431,46 +250,46 @@ int main(int argc, char **argv)
         }
     }
     if (!in || !out || !name) return usage("needs IN, -o OUT.rse and --name NAME");
+    if (!valid_name(name)) return usage("--name: 1..31 characters of a-z 0-9 _ -");
+    if (strlen(notes) > RS_ENV_MAX_NOTES / 2) return usage("--notes: at most 2048 bytes");
+
+    desc.name = name;
+    desc.key_yaw_deg = key_yaw;
     rs_error err = {0};
-    map m = {0};
+    rs_envmap src = {0}, work = {0};
+    uint8_t *mask = NULL;
     rs_env *e = NULL;
-    light L;
-    rs_result r = read_map(in, &m, &err);
-    if (r == RS_OK) r = extract_light(&m, &L, &err);
+    rs_env_light L;
+    rs_result r = rs_envmap_read(in, &src, &err);
+    if (r == RS_OK) r = rs_env_bake(&src, &desc, &e, &L, &work, &mask, &err);
     if (r == RS_OK) {
-        // Turn the world so the light sits at the key yaw.
-        float phi = atan2f(L.dir[0], L.dir[2]), dphi = key_yaw * PI_F / 180.0f - phi;
-        rotate_map(&m, dphi);
-        float c = cosf(dphi), s = sinf(dphi), x = L.dir[0], z = L.dir[2];
-        L.dir[0] = s * z + c * x, L.dir[2] = c * z - s * x;
-        r = rs_env_create(OUT_WIDTH, LEVELS, &e, &err);
-    }
-    if (r == RS_OK) {
-        snprintf(e->name, sizeof e->name, "%s", name);
-        memcpy(e->light_dir, L.dir, sizeof L.dir);
-        memcpy(e->light_color, L.color, sizeof L.color);
-        e->light_angle = L.angle;
-        project_sh(&m, e->sh);
-        for (int k = 0; k < LEVELS && r == RS_OK; k++) {
-            e->level_m[k] = level_m[k];
-            r = prefilter(&m, &e->levels[k], level_m[k], &err);
-        }
         const char *base = strrchr(in, '/');
-        snprintf(e->notes, sizeof e->notes, "%s%srouge-env: from %s, dominant light turned to yaw %g deg", notes,
-                 notes[0] ? "\n" : "", base ? base + 1 : in, (double)key_yaw);
-    }
-    if (r == RS_OK) r = rs_env_save(e, out, &err);
-    if (r == RS_OK && preview) r = write_preview(e, preview, &err);
-    if (r == RS_OK) {
         float pitch = asinf(RS_CLAMP(L.dir[1], -1.0f, 1.0f)) * 180.0f / PI_F;
-        printf("rouge-env: %s: light at yaw %.1f pitch %.1f deg, radius %.1f deg, colour %.3g %.3g %.3g; "
-               "SH ambient %.3g %.3g %.3g\n",
-               out, (double)key_yaw, (double)pitch, (double)(L.angle * 180.0f / PI_F), (double)L.color[0],
-               (double)L.color[1], (double)L.color[2], (double)(e->sh[0][0] * 0.282095f),
-               (double)(e->sh[0][1] * 0.282095f), (double)(e->sh[0][2] * 0.282095f));
+        snprintf(e->notes, sizeof e->notes,
+                 "%s%srouge-env %s: from %s (%dx%d), mirrored into the face frame (u grows towards the subject's "
+                 "left); dominant light turned to yaw %.1f deg, pitch %.1f deg, radius %.2f deg (%d texels of %dx%d "
+                 "above luminance %.3g, clamped to %.3g); levels m = 0.06 0.12 0.22 0.38 0.6 1.0",
+                 notes, notes[0] ? "\n" : "", ROUGE_ENV_VERSION, base ? base + 1 : in, src.w, src.h,
+                 (double)(atan2f(L.dir[0], L.dir[2]) * 180.0f / PI_F), (double)pitch,
+                 (double)(L.angle * 180.0f / PI_F), L.texels, work.w, work.h, (double)L.threshold,
+                 (double)(0.2126f * L.surround[0] + 0.7152f * L.surround[1] + 0.0722f * L.surround[2]));
+        r = rs_env_save(e, out, &err);
+    }
+    if (r == RS_OK && preview) r = write_preview(e, &work, mask, preview, &err);
+    if (r == RS_OK) {
+        float amb[3], up[3] = {0, 1, 0};
+        rs_env_sh_irradiance(e, up, amb);
+        printf("rouge-env: %s: light at yaw %.1f pitch %.1f deg, radius %.2f deg, colour %.3g %.3g %.3g; "
+               "SH irradiance from above %.3g %.3g %.3g\n",
+               out, (double)(atan2f(L.dir[0], L.dir[2]) * 180.0f / PI_F),
+               (double)(asinf(RS_CLAMP(L.dir[1], -1.0f, 1.0f)) * 180.0f / PI_F), (double)(L.angle * 180.0f / PI_F),
+               (double)L.color[0], (double)L.color[1], (double)L.color[2], (double)amb[0], (double)amb[1],
+               (double)amb[2]);
     }
     rs_env_destroy(e);
-    map_free(&m);
+    rs_envmap_free(&src);
+    rs_envmap_free(&work);
+    free(mask);
     if (r != RS_OK) {
         fprintf(stderr, "rouge-env: %s\n", err.msg);
         return 1;
