@@ -286,6 +286,32 @@ bad_input imgdiff_huge_png "rouge-imgdiff: PNG claiming 10^6 x 10^6 pixels" 2 "l
 bad_input imgdiff_dev_zero "rouge-imgdiff: /dev/zero" 2 "/dev/zero" - \
     "$imgdiff" /dev/zero tests/fixtures/image/a_8x8.png
 
+# ---- lighting environments: .rse files (rouge render --env) and HDR captures (rouge-env) ----
+envtool="$build/rouge-env"
+envfx=tests/fixtures/env
+bad_input rse_truncated ".rse: cut in half" 1 "bad_truncated.rse:" "$tmp/o.png" \
+    render "$face" --env "$envfx/bad_truncated.rse" -o "$tmp/o.png"
+bad_input rse_bad_crc ".rse: one texel bit flipped (CRC kept)" 1 "CRC" "$tmp/o.png" \
+    render "$face" --env "$envfx/bad_crc.rse" -o "$tmp/o.png"
+bad_input rse_huge_claim ".rse: claims 2048x1024 with 8 levels in 908 bytes (CRC recomputed)" 1 "bad_huge.rse:" \
+    "$tmp/o.png" render "$face" --env "$envfx/bad_huge.rse" -o "$tmp/o.png"
+bad_input rse_info_truncated "rouge-env --info on a truncated .rse" 1 "bad_truncated.rse:" - \
+    "$envtool" --info "$envfx/bad_truncated.rse"
+while IFS='|' read -r file pat what; do
+    bad_input "env_tool_${file%%.*}_${file#*.}" "rouge-env: $what" 1 "$pat" "$tmp/o.rse" \
+        "$envtool" "$envfx/$file" -o "$tmp/o.rse" --name x
+done <<'EOF'
+bad_truncated.hdr|the file ends at row|.hdr cut at 60% (run-length rows)
+bad_truncated_flat.hdr|truncated|flat .hdr cut short
+bad_huge.hdr|at most 8192x4096|.hdr header claiming 200000x100000
+bad_garbage.hdr|not a readable Radiance|.hdr magic then garbage
+bad_ratio.hdr|not a latitude-longitude map|a 64x64 .hdr (not 2:1)
+bad_truncated.exr|OpenEXR:|.exr cut at 70%
+bad_huge.exr|exceeds the maximum width|.exr header claiming 200000x100000
+bad_garbage.exr|OpenEXR:|.exr magic then garbage
+bad_not_hdr.png|neither OpenEXR nor Radiance|a PNG given as the capture
+EOF
+
 # ---- inputs that once crashed a fuzz harness: the real programs must refuse them cleanly too ----
 for f in "$bad"/fuzz/ply/*; do
     [ -f "$f" ] || continue
