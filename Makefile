@@ -210,7 +210,7 @@ ENV_SRC := /usr/share/blender/datafiles/studiolights/world
 ENV_NOTE = Source: Blender studiolights world/$(2).exr (Debian blender-data), by Greg Zaal (HDRI Haven), CC0 1.0
 envs: deps $(BUILD)/rouge-env
 	$(BUILD)/rouge-env $(ENV_SRC)/studio.exr -o assets/env/studio.rse --name studio --notes "$(call ENV_NOTE,,studio)"
-	$(BUILD)/rouge-env $(ENV_SRC)/courtyard.exr -o assets/env/daylight.rse --name daylight --notes "$(call ENV_NOTE,,courtyard)"
+	$(BUILD)/rouge-env $(ENV_SRC)/city.exr -o assets/env/daylight.rse --name daylight --notes "$(call ENV_NOTE,,city)"
 	$(BUILD)/rouge-env $(ENV_SRC)/interior.exr -o assets/env/office.rse --name office --notes "$(call ENV_NOTE,,interior)"
 	$(BUILD)/rouge-env $(ENV_SRC)/sunset.exr -o assets/env/sunset.rse --name sunset --notes "$(call ENV_NOTE,,sunset)"
 

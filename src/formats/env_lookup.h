@@ -12,7 +12,7 @@
 
 #include "formats/env.h"
 
-#define RS_ENV_DEFAULT "daylight"
+#define RS_ENV_DEFAULT "studio"
 #define RS_ENV_PAPER "paper"     // not a file: the paper's key light + ambient
 #define RS_ENV_NAME_LIST "studio|daylight|office|sunset|paper"
 

@@ -67,9 +67,9 @@ static const rs_cosmetic presets[] = {
     {"eyeshadow_champagne", RS_COSMETIC_EYESHADOW, {222, 192, 152}, 0.55f, 0.80f, 1.00f, 0.22f, 0.40f, 0.07f, 0.60f,
      0.0f, 0.60f, 0.0f},
     // Eyeliner: near-black, opaque (coverage 1: its black is not lifted to the face's darkest colour),
-    // fine hard line; liquid liner dries to a soft sheen (a faint coat).
-    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.30f, 0.22f, 0.02f, 1.00f,
-     0.15f, 0.0f, 1.00f},
+    // fine hard line; a matte gel liner (a glossy one mirrors the softboxes as a grey streak along it).
+    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.38f, 0.10f, 0.02f, 1.00f,
+     0.0f, 0.0f, 1.00f},
 };
 
 uint32_t rs_cosmetic_count(void) { return (uint32_t)RS_COUNT_OF(presets); }
