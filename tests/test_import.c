@@ -1,5 +1,6 @@
 // test_import.c — rouge-pack's import (tools/pack/import.h): models through assimp into the converter's
-// mesh, texture pages, embedded images, vertex colours, declared units, and bad inputs.
+// mesh, texture pages, embedded images, vertex colours, declared units and the scale rule, bad inputs;
+// and the face frame of a scan in any orientation, also of a face-only scan.
 #define _POSIX_C_SOURCE 200809L
 #include "support/harness.h"
 #include "pack/import.h"
@@ -264,6 +265,240 @@ static void test_jpeg_and_png_textures_decode_with_limits(void)
     }
 }
 
+// The scale rule (pack.h): a given unit wins; a declared one is used when the head it gives is a head;
+// else the one standard unit that makes the head 150..300 mm; else the head is taken as 225 mm. The
+// committed OBJ head is 4.7 units tall: scaled to mm, cm and m it must read as those units.
+static void test_scale_rule_reads_units_from_the_head(void)
+{
+    rs_error err = {0};
+    rs_import_scene *s = NULL;
+    RS_REQUIRE(rs_import_load(FX "head/head.obj", &s, &err) == RS_OK, "%s", err.msg);
+    rs_ply_mesh *m = s->mesh;
+    float(*orig)[3] = malloc((size_t)m->vertex_count * sizeof *orig);
+    RS_REQUIRE(orig, "out of memory");
+    memcpy(orig, m->pos, (size_t)m->vertex_count * sizeof *orig);
+    static const struct {
+        float scale, given, declared;  // positions x scale; desc.mm_per_unit; desc.declared_mm_per_unit
+        rs_pack_scale want;
+        float want_mm;                 // 0: the estimate, 225 mm / face height
+    } cases[] = {
+        {47.0f, 0, 0, RS_PACK_SCALE_INFERRED, 1.0f},        // millimetres
+        {4.7f, 0, 0, RS_PACK_SCALE_INFERRED, 10.0f},        // centimetres
+        {0.047f, 0, 0, RS_PACK_SCALE_INFERRED, 1000.0f},    // metres
+        {1.85f, 0, 0, RS_PACK_SCALE_INFERRED, 25.4f},       // inches
+        {1.0f, 0, 0, RS_PACK_SCALE_ESTIMATED, 0},           // 4.7 units: no unit gives a head
+        {1.0f, 0, 1000.0f, RS_PACK_SCALE_ESTIMATED, 0},     // "metres" for a 4.7 m head: ignored
+        {0.047f, 0, 1000.0f, RS_PACK_SCALE_DECLARED, 1000.0f},
+        {0.08f, 0, 1000.0f, RS_PACK_SCALE_DECLARED, 1000.0f},  // a big (375 mm) head: declared still holds
+        {47.0f, 2.0f, 1000.0f, RS_PACK_SCALE_GIVEN, 2.0f},
+    };
+    for (size_t k = 0; k < RS_COUNT_OF(cases); k++) {
+        for (uint32_t i = 0; i < m->vertex_count; i++)
+            for (int a = 0; a < 3; a++) m->pos[i][a] = orig[i][a] * cases[k].scale;
+        rs_pack_desc d = {.points = 20000, .mm_per_unit = cases[k].given, .declared_mm_per_unit = cases[k].declared,
+                          .declared_unit = "test"};
+        rs_pack_report rep;
+        rs_splat_cloud *c = NULL;
+        if (!RS_CHECK(rs_pack_convert(m, &d, &c, &rep, &err) == RS_OK, "case %zu: %s", k, err.msg)) continue;
+        float want = cases[k].want_mm ? cases[k].want_mm : RS_PACK_ASSUMED_HEAD_MM / c->hdr.face_height;
+        RS_CHECK(rep.face.found && rep.scale == cases[k].want && fabsf(c->hdr.mm_per_unit - want) < 1e-3f * want,
+                 "case %zu (x%g): rule %d, %g mm per unit (%s); wanted rule %d, %g", k, cases[k].scale, rep.scale,
+                 c->hdr.mm_per_unit, rep.scale_why, cases[k].want, want);
+        rs_splat_destroy(c);
+    }
+    free(orig);
+    rs_import_destroy(s);
+    RS_CHECK(rs_pack_unit_parse("mm") == 1.0f && rs_pack_unit_parse("in") == 25.4f && rs_pack_unit_parse("m") == 1000.0f &&
+                 rs_pack_unit_parse("ft") == 0 && rs_pack_unit_parse(NULL) == 0,
+             "unit names");
+}
+
+// ---- the face frame in any orientation, and face-only scans (tools/pack/pack_frame.c, pack_face.c) ----
+// On a 40k LOD prefix of the bundled face (assets/face.rsf), so no shared data is needed.
+
+#define N_POINTS 40000
+
+typedef struct scan {
+    uint32_t n;
+    float (*pos)[3], (*nrm)[3];
+} scan;
+
+static float dot3(const float a[3], const float b[3])
+{
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static double angle_deg(const float a[3], const float b[3])
+{
+    return acos(RS_CLAMP(dot3(a, b), -1.0f, 1.0f)) * 57.29577951;
+}
+
+static bool load_face(scan *s)
+{
+    rs_splat_cloud *c = NULL;
+    rs_error err = {0};
+    if (!RS_CHECK(rs_splat_load("assets/face.rsf", &c, &err) == RS_OK, "%s", err.msg)) return false;
+    s->n = rs_splat_lod_count(c, N_POINTS);
+    s->pos = malloc((size_t)s->n * sizeof *s->pos);
+    s->nrm = malloc((size_t)s->n * sizeof *s->nrm);
+    for (uint32_t i = 0; i < s->n; i++) {
+        rs_splat sp;
+        rs_splat_get(c, i, &sp);
+        memcpy(s->pos[i], sp.pos, sizeof sp.pos);
+        memcpy(s->nrm[i], sp.normal, sizeof sp.normal);
+    }
+    rs_splat_destroy(c);
+    return true;
+}
+
+static void scan_free(scan *s)
+{
+    free(s->pos);
+    free(s->nrm);
+}
+
+// A uniformly random rotation (Shoemake's quaternion from three uniforms) as a matrix.
+static void random_rotation(rs_pack_rng *r, float m[3][3])
+{
+    double u1 = rs_pack_rng_unit(r), u2 = rs_pack_rng_unit(r) * 6.283185307, u3 = rs_pack_rng_unit(r) * 6.283185307;
+    double a = sqrt(1 - u1), b = sqrt(u1);
+    double x = a * sin(u2), y = a * cos(u2), z = b * sin(u3), w = b * cos(u3);
+    double q[3][3] = {{1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)},
+                      {2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)},
+                      {2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)}};
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) m[i][j] = (float)q[i][j];
+}
+
+static void apply(const float m[3][3], const float v[3], const float t[3], float out[3])
+{
+    float r[3];
+    for (int i = 0; i < 3; i++) r[i] = m[i][0] * v[0] + m[i][1] * v[1] + m[i][2] * v[2] + (t ? t[i] : 0);
+    memcpy(out, r, sizeof r);
+}
+
+// Face frame and regions of a scan with no axes given.
+static bool analyse(const scan *s, rs_pack_face *f, uint8_t *region)
+{
+    rs_error err = {0};
+    if (!RS_CHECK(rs_pack_find_face((const float(*)[3])s->pos, (const float(*)[3])s->nrm, s->n, RS_PACK_AXIS_DEFAULT,
+                                    RS_PACK_AXIS_DEFAULT, f, &err) == RS_OK, "%s", err.msg))
+        return false;
+    memset(region, RS_PACK_REGION_AUTO, s->n);
+    rs_pack_segment((const float(*)[3])s->pos, (const float(*)[3])s->nrm, s->n, f, region);
+    return true;
+}
+
+// Compares a frame found on a moved scan with the reference frame moved the same way.
+// Tolerances: angles in degrees, the face height as a fraction, the least fraction of equal region labels.
+typedef struct tol {
+    double angle, height, agree;
+} tol;
+
+static void compare(const char *what, const rs_pack_face *ref, const float m[3][3], const float t[3], const rs_pack_face *got,
+                    const uint8_t *ref_region, const uint8_t *region, const uint32_t *ids, uint32_t n, tol tl)
+{
+    float fw[3], up[3], nose[3], centre[3];
+    apply(m, ref->forward, NULL, fw);
+    apply(m, ref->up, NULL, up);
+    apply(m, ref->nose_tip, t, nose);
+    apply(m, ref->centre, t, centre);
+    float dn[3] = {nose[0] - got->nose_tip[0], nose[1] - got->nose_tip[1], nose[2] - got->nose_tip[2]};
+    double a_fw = angle_deg(fw, got->forward), a_up = angle_deg(up, got->up), d_nose = sqrt(dot3(dn, dn)) / ref->face_height;
+    uint32_t same = 0;
+    for (uint32_t i = 0; i < n; i++) same += region[i] == ref_region[ids ? ids[i] : i];
+    double agree = (double)same / n;
+    printf("# %s: forward %.2f deg, up %.2f deg, nose tip %.4f H, face height %.3f vs %.3f, regions agree %.1f%%\n", what,
+           a_fw, a_up, d_nose, got->face_height, ref->face_height, 100 * agree);
+    RS_CHECK(got->found && a_fw < tl.angle && a_up < tl.angle && d_nose < 0.01 &&
+                 fabs(got->face_height - ref->face_height) < tl.height * ref->face_height && agree >= tl.agree,
+             "%s: found %d, forward off by %.2f deg, up %.2f deg, nose tip %.4f H, face height %.3f vs %.3f, regions agree "
+             "%.1f%%",
+             what, got->found, a_fw, a_up, d_nose, got->face_height, ref->face_height, 100 * agree);
+}
+
+static void test_frame_survives_random_rotations(void)
+{
+    scan s;
+    if (!load_face(&s)) return;
+    rs_pack_face ref;
+    uint8_t *ref_region = malloc(s.n), *region = malloc(s.n);
+    scan r = {.n = s.n, .pos = malloc((size_t)s.n * sizeof *s.pos), .nrm = malloc((size_t)s.n * sizeof *s.nrm)};
+    if (analyse(&s, &ref, ref_region)) {
+        RS_CHECK(ref.found && ref.up[1] > 0.98f && ref.forward[2] > 0.98f, "upright scan: up %.3f %.3f %.3f, forward %.3f %.3f %.3f",
+                 ref.up[0], ref.up[1], ref.up[2], ref.forward[0], ref.forward[1], ref.forward[2]);
+        rs_pack_rng rng;
+        rs_pack_rng_seed(&rng, 1414);
+        for (int k = 0; k < 8; k++) {
+            float m[3][3], t[3] = {(float)rs_pack_rng_unit(&rng) * 20 - 10, (float)rs_pack_rng_unit(&rng) * 20 - 10,
+                                   (float)rs_pack_rng_unit(&rng) * 20 - 10};
+            random_rotation(&rng, m);
+            for (uint32_t i = 0; i < s.n; i++) {
+                apply(m, s.pos[i], t, r.pos[i]);
+                apply(m, s.nrm[i], NULL, r.nrm[i]);
+            }
+            rs_pack_face got;
+            char what[32];
+            snprintf(what, sizeof what, "rotation %d", k);
+            if (analyse(&r, &got, region)) compare(what, &ref, m, t, &got, ref_region, region, NULL, s.n, (tol){3, 0.03, 0.97});
+        }
+    }
+    free(ref_region);
+    free(region);
+    scan_free(&r);
+    scan_free(&s);
+}
+
+// A face-only scan (what a phone's front camera captures): the points in front of the ears, none of the
+// back of the head or the neck below the chin, in a random orientation. It must still find the face and
+// label the skin regions as on the whole head.
+static void test_partial_scan_keeps_face_and_regions(void)
+{
+    scan s;
+    if (!load_face(&s)) return;
+    rs_pack_face ref;
+    uint8_t *ref_region = malloc(s.n), *region = malloc(s.n);
+    uint32_t *ids = malloc((size_t)s.n * sizeof *ids);
+    scan p = {.pos = malloc((size_t)s.n * sizeof *s.pos), .nrm = malloc((size_t)s.n * sizeof *s.nrm)};
+    if (analyse(&s, &ref, ref_region)) {
+        float H = ref.face_height;
+        for (uint32_t i = 0; i < s.n; i++) {
+            float d[3] = {s.pos[i][0] - ref.nose_tip[0], s.pos[i][1] - ref.nose_tip[1], s.pos[i][2] - ref.nose_tip[2]};
+            float df = dot3(d, ref.forward) / H, du = dot3(d, ref.up) / H;
+            if (df < -0.3f || du < -0.42f || du > 0.36f) continue;  // cut at the hairline and before the ears; chin in
+            ids[p.n++] = i;
+        }
+        rs_pack_rng rng;
+        rs_pack_rng_seed(&rng, 77);
+        float m[3][3], t[3] = {3, -2, 5};
+        random_rotation(&rng, m);
+        for (uint32_t j = 0; j < p.n; j++) {
+            apply(m, s.pos[ids[j]], t, p.pos[j]);
+            apply(m, s.nrm[ids[j]], NULL, p.nrm[j]);
+        }
+        rs_pack_face got;
+        if (analyse(&p, &got, region)) {
+            // The face height comes from the lips here (no crown), so a little more slack.
+            RS_CHECK(!got.crown, "the face-only scan has a crown");
+            compare("face-only scan", &ref, m, t, &got, ref_region, region, ids, p.n, (tol){5, 0.08, 0.90});
+            uint32_t lips = 0, nose = 0, cheek = 0, forehead = 0;
+            for (uint32_t j = 0; j < p.n; j++) {
+                lips += region[j] == RS_REGION_LIPS;
+                nose += region[j] == RS_REGION_NOSE;
+                cheek += region[j] == RS_REGION_CHEEK;
+                forehead += region[j] == RS_REGION_FOREHEAD;
+            }
+            RS_CHECK(lips && nose && cheek && forehead, "regions: lips %u nose %u cheek %u forehead %u of %u", lips, nose, cheek,
+                     forehead, p.n);
+        }
+    }
+    free(ref_region);
+    free(region);
+    free(ids);
+    scan_free(&p);
+    scan_free(&s);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -275,5 +510,8 @@ int main(int argc, char **argv)
     RS_RUN(test_memory_import_matches_file);
     RS_RUN(test_jpeg_and_png_textures_decode_with_limits);
     RS_RUN(test_lee_perry_smith_glb_matches_ply);
+    RS_RUN(test_scale_rule_reads_units_from_the_head);
+    RS_RUN(test_frame_survives_random_rotations);
+    RS_RUN(test_partial_scan_keeps_face_and_regions);
     return rs_test_finish();
 }

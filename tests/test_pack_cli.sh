@@ -40,6 +40,8 @@ expect pack_missing_value 2 "--points needs a value" "$pack" "$fx/points_le.ply"
 expect pack_bad_number 2 "--points: expected a count" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --points 12abc
 expect pack_zero_points 2 "--points" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --points 0
 expect pack_bad_mm 2 "--mm-per-unit" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --mm-per-unit -3
+expect pack_bad_units 2 "--units: expected mm, cm, m or in" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --units furlong
+expect pack_units_and_mm 2 "use one" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --units mm --mm-per-unit 2
 expect pack_bad_axis 2 "--up: expected an axis" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --up sideways
 expect pack_parallel_axes 2 "different axes" "$pack" "$fx/points_le.ply" -o "$tmp/a.rsf" --up +z --forward -z
 expect pack_two_inputs 2 "more than one input" "$pack" "$fx/points_le.ply" "$fx/points_be.ply" -o "$tmp/a.rsf"

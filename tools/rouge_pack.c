@@ -43,11 +43,18 @@ static const char usage[] =
     "                      area) is kept, which on a scan is the skin, not caps or mouth/eye pockets\n"
     "  Inputs without colour get a light warm grey (sRGB 200 178 160).\n"
     "\n"
-    "Face (assumed: one upright, front-facing head; the nose is the sharpest forward bump of the face):\n"
-    "  --up AXIS           +x -x +y -y +z -z (default +y)\n"
-    "  --forward AXIS      the direction the face looks (default +z)\n"
-    "  --mm-per-unit X     physical scale; default: estimated from the head height (vertex to chin)\n"
-    "                      taken as 225 mm. The bundled head is about 47 mm per unit\n"
+    "Face (one front-facing head: a bust, a whole head or a face-only scan; the nose is its sharpest\n"
+    "bump). Its frame is found from the scan in any orientation: the mirror plane, the nose, the\n"
+    "face's mean normal, and a depth template of the face for up versus down. To fix it, give axes:\n"
+    "  --up AXIS           +x -x +y -y +z -z (with --up or --forward given: default +y)\n"
+    "  --forward AXIS      the direction the face looks (default then +z)\n"
+    "  --units U           the scan's unit: mm, cm, m or in\n"
+    "  --mm-per-unit X     the same as a number (the bundled head is about 47 mm per unit)\n"
+    "  Scale (it sets the skin's scattering width) when neither is given: the unit the file declares\n"
+    "  (glTF: metres; FBX: UnitScaleFactor; DAE: <unit>) unless it makes the head (vertex to chin)\n"
+    "  shorter than 60 mm or taller than 600 mm; else the first of mm, cm, m, in that makes the head\n"
+    "  150..300 mm tall (only one can); else the head is taken as 225 mm. The summary says which rule\n"
+    "  applied; an inferred or estimated scale is also noted on stderr, even with -q\n"
     "\n"
     "Output:\n"
     "  -o, --output FILE   the .rsf to write (atomically: no file is left on failure)\n"
@@ -187,6 +194,8 @@ typedef struct options {
     rs_pack_desc desc;
     bool quiet;
     char format[64];          // what the input was read as ("PLY", "glTF 2.0", ...)
+    char declared_unit[96];   // the unit the file declares, in words (or "")
+    const char *units;        // --units as given
     uint32_t pages_textured;  // materials whose own texture coloured the splats
 } options;
 
@@ -231,8 +240,7 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
     } else {
         printf("  face          not found: every splat is `other` (see --help for the assumptions)\n");
     }
-    printf("  mm_per_unit   %.3f%s\n", c->hdr.mm_per_unit,
-           rep->mm_estimated ? " (estimated: head height taken as 225 mm; set --mm-per-unit if known)" : "");
+    printf("  mm_per_unit   %.4g (%s)\n", c->hdr.mm_per_unit, rep->scale_why);
     printf("  regions      ");
     for (uint32_t i = 0; i < c->hdr.region_count; i++)
         printf(" %s %.1f%%", c->hdr.regions[i].name, 100.0 * c->region_counts[i] / c->hdr.count);
@@ -269,6 +277,9 @@ static int convert(options *o)
     if (rs_import_load(o->input, &scene, &err) != RS_OK) return fail(1, "%s", err.msg);
     rs_ply_mesh *mesh = scene->mesh;
     snprintf(o->format, sizeof o->format, "%s", scene->format_name);
+    snprintf(o->declared_unit, sizeof o->declared_unit, "%s", scene->unit_source);
+    o->desc.declared_mm_per_unit = scene->declared_mm_per_unit;
+    o->desc.declared_unit = o->declared_unit;
     // Shown even with -q: the file was accepted on a reading the format does not spell out.
     if (mesh->warnings[0]) {
         char w[sizeof mesh->warnings * 4];
@@ -357,9 +368,13 @@ static int convert(options *o)
         return fail(1, "%s", err.msg);
     }
     if (!o->quiet) print_summary(o, cloud, &rep, load_s, save_s);
+    // Said even with -q: the scale sets the skin's scattering width, and here it is a guess.
+    if (rep.scale == RS_PACK_SCALE_INFERRED || rep.scale == RS_PACK_SCALE_ESTIMATED)
+        fprintf(stderr, "rouge-pack: note: %s: scale %.4g mm per unit, %s; set --units if not\n", o->input,
+                cloud->hdr.mm_per_unit, rep.scale_why);
     // Said even with -q (on stderr, once the file is written): the result is not what the face defaults give.
     if (!rep.face.found)
-        fprintf(stderr, "rouge-pack: note: %s: no face found (assumed +y up, +z forward); converted %s as a plain "
+        fprintf(stderr, "rouge-pack: note: %s: no face found (in any orientation, nor +y up, +z forward); converted %s as a plain "
                         "model, framed by its bounding box\n", o->input, whole ? "every component" : "it");
     rs_splat_destroy(cloud);
     return 0;
@@ -369,6 +384,7 @@ int main(int argc, char **argv)
 {
     options o = {0};
     const char *info_path = NULL;
+    bool mm_given = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         // Flags that take a value: the value is the next argument.
@@ -388,7 +404,7 @@ int main(int argc, char **argv)
             takes = false;
         } else if (a[0] == '-' && a[1] != 0) {
             static const char *const known[] = {"-o", "--output", "--points", "--texture", "--normal-map",
-                                                "--specular-map", "--region-map", "--mm-per-unit", "--min-lod",
+                                                "--specular-map", "--region-map", "--mm-per-unit", "--units", "--min-lod",
                                                 "--seed", "--up", "--forward", "--preview", "--info"};
             bool ok = false;
             for (size_t k = 0; k < RS_COUNT_OF(known); k++) ok |= !strcmp(a, known[k]);
@@ -414,8 +430,12 @@ int main(int argc, char **argv)
         } else if (!strcmp(a, "--seed")) {
             if (!parse_u64(v, 0, UINT64_MAX, &n)) return fail(2, "--seed: expected a non-negative integer, got '%s'", v);
             o.desc.seed = n;
+        } else if (!strcmp(a, "--units")) {
+            if (!(o.desc.mm_per_unit = rs_pack_unit_parse(v))) return fail(2, "--units: expected mm, cm, m or in, got '%s'", v);
+            o.units = v;
         } else if (!strcmp(a, "--mm-per-unit")) {
             if (!parse_float(v, &o.desc.mm_per_unit)) return fail(2, "--mm-per-unit: expected a number > 0, got '%s'", v);
+            mm_given = true;
         } else if (!strcmp(a, "--up") || !strcmp(a, "--forward")) {
             rs_pack_axis ax = rs_pack_axis_parse(v);
             if (ax == RS_PACK_AXIS_DEFAULT) return fail(2, "%s: expected an axis +x -x +y -y +z -z, got '%s'", a, v);
@@ -430,6 +450,7 @@ int main(int argc, char **argv)
         return info(info_path, o.preview);
     }
     if (!o.input) return fail(2, "no input scan (see --help)");
+    if (o.units && mm_given) return fail(2, "--units and --mm-per-unit both give the scale: use one");
     rs_pack_axis up = o.desc.up ? o.desc.up : RS_PACK_AXIS_POS_Y, fwd = o.desc.forward ? o.desc.forward : RS_PACK_AXIS_POS_Z;
     if ((up - 1) / 2 == (fwd - 1) / 2) return fail(2, "--up and --forward must be different axes");
     if (!o.output) return fail(2, "no output: give -o OUT.rsf");

@@ -32,6 +32,27 @@
 #define RS_PACK_DEFAULT_RGB_B 160
 // Head height (vertex to menton) assumed when estimating mm_per_unit: adult men 225-232 mm, women ~218.
 #define RS_PACK_ASSUMED_HEAD_MM 225.0f
+// The scale rule (rouge-pack --help, docs/import.md). A scale given by the user wins; else the unit the
+// file declares, unless it makes the head shorter than RS_PACK_DECLARED_HEAD_MIN_MM or taller than
+// RS_PACK_DECLARED_HEAD_MAX_MM (LeePerrySmith.glb's "metres" make a 4.7 m head); else the first of mm,
+// cm, m, in that makes the head RS_PACK_HEAD_MIN_MM..RS_PACK_HEAD_MAX_MM tall (a toddler's head is about
+// 170 mm, an adult's up to ~260; the range is narrower than the 2.54 between cm and in, so at most one
+// unit fits, and it keeps the bundled head's 4.75 units from reading as a 121 mm head in inches); else
+// the head is taken as RS_PACK_ASSUMED_HEAD_MM.
+#define RS_PACK_HEAD_MIN_MM 150.0f
+#define RS_PACK_HEAD_MAX_MM 300.0f
+#define RS_PACK_DECLARED_HEAD_MIN_MM 60.0f
+#define RS_PACK_DECLARED_HEAD_MAX_MM 600.0f
+
+typedef enum rs_pack_scale {
+    RS_PACK_SCALE_GIVEN,      // desc.mm_per_unit (--units, --mm-per-unit)
+    RS_PACK_SCALE_DECLARED,   // the file's own unit (desc.declared_mm_per_unit)
+    RS_PACK_SCALE_INFERRED,   // the standard unit that makes the head a head's size
+    RS_PACK_SCALE_ESTIMATED,  // none fits (or no face): the head taken as RS_PACK_ASSUMED_HEAD_MM
+} rs_pack_scale;
+
+// Millimetres per unit of "mm", "cm", "m", "in" (also "inch"); 0 for anything else.
+float rs_pack_unit_parse(const char *s);
 
 // ---------------------------------------------------------------------------------------------------
 // Small shared pieces: deterministic random numbers, Morton codes.
@@ -177,12 +198,24 @@ typedef struct rs_pack_face {
     float face_height;        // vertex to menton, model units
     float face_width;         // silhouette width at the nose tip's height (ears included), model units
     float centre[3];          // centre of the head (orbit centre); the mirror plane goes through it
+    bool crown;               // the scan has the top of the head (false: a face-only scan; H from the lips)
 } rs_pack_face;
 
-// Finds the face of a front-facing head. Assumptions: the head is upright along `up` (within ~20 deg)
-// and looks roughly along `forward`; the nose is the sharpest forward protrusion of the upper face.
+// Finds the face of a head. With both axes RS_PACK_AXIS_DEFAULT the frame comes from the scan itself in
+// any orientation (rs_pack_orient); when that finds no face, or with axes given, the head is assumed
+// upright along `up` (within ~20 deg, default +Y) and looking roughly along `forward` (default +Z).
+// The nose is the sharpest forward protrusion of the upper face.
 rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uint32_t count,
                             rs_pack_axis up, rs_pack_axis forward, rs_pack_face *out, rs_error *err);
+// The same in a given frame (unit, orthogonal vectors).
+rs_result rs_pack_find_face_frame(const float (*pos)[3], const float (*normal)[3], uint32_t count, const float up[3],
+                                  const float forward[3], rs_pack_face *out, rs_error *err);
+// The face frame of a scan in any orientation (pack_frame.c): the mirror plane gives the side, the nose
+// tip and the mean normal of the face around it the forward, a depth template of the face up from down.
+// Needs outward normals; *found is false when no face could be read.
+// *mirror_offset: the mirror plane is { p : p . side = *mirror_offset }, side = up x forward.
+rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32_t count, float up[3], float forward[3],
+                         float *mirror_offset, bool *found, rs_error *err);
 
 // Fills every RS_PACK_REGION_AUTO entry of region[] by geometry relative to the face landmarks
 // (docs/regions.md); colour is not used. Without a face, AUTO becomes other.
@@ -213,7 +246,9 @@ typedef struct rs_pack_desc {
     const rs_image *texture, *normal_map, *specular_map, *region_map;  // need texture coordinates
     const rs_image *pages;        // mesh: per-material colour pages when texture is NULL (see sampling)
     uint32_t page_count;
-    float mm_per_unit;            // 0 = estimate from the head height (RS_PACK_ASSUMED_HEAD_MM)
+    float mm_per_unit;            // 0 = the scale rule above (declared, inferred or estimated)
+    float declared_mm_per_unit;   // the unit the input file declares (0 = none), and why ("glTF: metres")
+    const char *declared_unit;
     uint32_t min_lod;             // smallest LOD prefix (0 = RS_PACK_DEFAULT_MIN_LOD)
     rs_pack_axis up, forward;     // 0 = +Y up, +Z forward
     const char *notes;            // appended to the input's PLY comments in the header notes
@@ -227,7 +262,9 @@ typedef struct rs_pack_report {
     uint32_t triangles_dropped;   // outside the largest component
     uint32_t duplicates_dropped;  // points at the same position as another
     uint32_t splats;
-    bool sampled_mesh, normals_estimated, colour_default, mm_estimated;
+    bool sampled_mesh, normals_estimated, colour_default, mm_estimated;  // mm_estimated: scale == ESTIMATED
+    rs_pack_scale scale;          // which rule set mm_per_unit, and in words why
+    char scale_why[256];
     uint32_t normals_replaced;  // input normals that were zero or not finite, re-estimated (0: all usable)
     uint32_t regions_given;       // splats whose region came from the input (map or PLY property)
     rs_pack_face face;

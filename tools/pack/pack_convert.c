@@ -2,6 +2,7 @@
 #include "pack/pack.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -177,6 +178,79 @@ static void make_notes(char *dst, const char *comments, const char *extra)
     dst[n] = 0;
 }
 
+float rs_pack_unit_parse(const char *s)
+{
+    static const struct {
+        const char *name;
+        float mm;
+    } units[] = {{"mm", 1.0f}, {"cm", 10.0f}, {"m", 1000.0f}, {"in", 25.4f}, {"inch", 25.4f}};
+    for (size_t i = 0; s && i < RS_COUNT_OF(units); i++)
+        if (!strcmp(s, units[i].name)) return units[i].mm;
+    return 0;
+}
+
+static const char *unit_name(float mm_per_unit)
+{
+    return mm_per_unit == 1.0f ? "mm" : mm_per_unit == 10.0f ? "cm" : mm_per_unit == 1000.0f ? "m" : mm_per_unit == 25.4f ? "in" : NULL;
+}
+
+// The scale rule (pack.h): given, declared (if plausible), inferred from the head's size, estimated.
+static float choose_scale(const rs_pack_desc *d, const rs_pack_face *f, rs_pack_report *rep)
+{
+    float H = f->face_height;
+    if (d->mm_per_unit > 0) {
+        const char *u = unit_name(d->mm_per_unit);
+        rep->scale = RS_PACK_SCALE_GIVEN;
+        snprintf(rep->scale_why, sizeof rep->scale_why, "given%s%s", u ? ": " : "", u ? u : "");
+        return d->mm_per_unit;
+    }
+    const char *src = d->declared_unit ? d->declared_unit : "the file's unit";
+    bool declared = d->declared_mm_per_unit > 0 && isfinite(d->declared_mm_per_unit);
+    if (declared && !f->found) {
+        rep->scale = RS_PACK_SCALE_DECLARED;
+        snprintf(rep->scale_why, sizeof rep->scale_why, "declared: %s", src);
+        return d->declared_mm_per_unit;
+    }
+    if (declared) {
+        float mm = H * d->declared_mm_per_unit;
+        if (mm >= RS_PACK_DECLARED_HEAD_MIN_MM && mm <= RS_PACK_DECLARED_HEAD_MAX_MM) {
+            rep->scale = RS_PACK_SCALE_DECLARED;
+            snprintf(rep->scale_why, sizeof rep->scale_why, "declared: %s; the head is %.0f mm tall", src, mm);
+            return d->declared_mm_per_unit;
+        }
+    }
+    char ignored[160] = "";
+    if (declared) {
+        float mm = H * d->declared_mm_per_unit;
+        snprintf(ignored, sizeof ignored, "%s would make the head %.3g %s tall, ignored; ", src, mm >= 1000 ? mm / 1000 : mm,
+                 mm >= 1000 ? "m" : "mm");
+    }
+    static const float units[4] = {1.0f, 10.0f, 1000.0f, 25.4f};
+    static const char *names[4] = {"millimetres", "centimetres", "metres", "inches"};
+    for (int k = 0; k < 4 && f->found; k++) {
+        float mm = H * units[k];
+        if (mm >= RS_PACK_HEAD_MIN_MM && mm <= RS_PACK_HEAD_MAX_MM) {
+            rep->scale = RS_PACK_SCALE_INFERRED;
+            snprintf(rep->scale_why, sizeof rep->scale_why, "%sinferred: in %s the head is %.0f mm tall (a head is %.0f..%.0f mm)",
+                     ignored, names[k], mm, RS_PACK_HEAD_MIN_MM, RS_PACK_HEAD_MAX_MM);
+            return units[k];
+        }
+    }
+    rep->scale = RS_PACK_SCALE_ESTIMATED;
+    rep->mm_estimated = true;
+    float mm = RS_PACK_ASSUMED_HEAD_MM / H;
+    // A degenerate scan (a line, a speck): no scale to read; 1 mm per unit keeps the header valid.
+    if (!isfinite(mm) || !(mm > 0)) mm = 1.0f;
+    if (f->found)
+        snprintf(rep->scale_why, sizeof rep->scale_why,
+                 "%sestimated: no unit (mm, cm, m, in) makes the head %.0f..%.0f mm tall, so it is taken as %.0f mm", ignored,
+                 RS_PACK_HEAD_MIN_MM, RS_PACK_HEAD_MAX_MM, RS_PACK_ASSUMED_HEAD_MM);
+    else
+        snprintf(rep->scale_why, sizeof rep->scale_why, "estimated: no face to measure, the model's size taken as %.0f mm",
+                 RS_PACK_ASSUMED_HEAD_MM);
+    return mm;
+}
+
 rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_splat_cloud **out,
                           rs_pack_report *report, rs_error *err)
 {
@@ -211,6 +285,8 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     }
     if (d->mm_per_unit != 0 && !(d->mm_per_unit > 0 && isfinite(d->mm_per_unit)))
         return rs_fail(err, RS_ERR_ARG, "mm per unit %g must be a finite number > 0", d->mm_per_unit);
+    if (d->declared_mm_per_unit != 0 && !(d->declared_mm_per_unit > 0 && isfinite(d->declared_mm_per_unit)))
+        return rs_fail(err, RS_ERR_ARG, "declared mm per unit %g must be a finite number > 0", d->declared_mm_per_unit);
 
     rs_pack_points p = {0};
     rs_pack_knn knn = {0};
@@ -356,13 +432,7 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     memcpy(hdr->up, f->up, sizeof hdr->up);
     memcpy(hdr->centre, f->centre, sizeof hdr->centre);
     hdr->face_height = f->face_height;
-    hdr->mm_per_unit = d->mm_per_unit;
-    if (hdr->mm_per_unit == 0) {
-        hdr->mm_per_unit = RS_PACK_ASSUMED_HEAD_MM / f->face_height;
-        // A degenerate scan (a line, a speck): no scale to read; 1 mm per unit keeps the header valid.
-        if (!isfinite(hdr->mm_per_unit) || !(hdr->mm_per_unit > 0)) hdr->mm_per_unit = 1.0f;
-        rep->mm_estimated = true;
-    }
+    hdr->mm_per_unit = choose_scale(d, f, rep);
     rs_splat_default_regions(hdr);
     make_notes(hdr->notes, in->comments, d->notes);
     r = rs_splat_create(splats, n, hdr, out, err);

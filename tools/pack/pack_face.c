@@ -6,8 +6,8 @@
 //      first narrowing below the head (neck or chin), hence a rough head size H0;
 //   2. the nose tip is the cell of the upper-middle face that stands out most from a ring around it
 //      (the nose is narrow and protrudes ~2 cm; the chin and brows are broad, the cheeks recede);
-//   3. face height H = (top - nose tip) / 0.605 (vertex-pronasale is ~0.6 of vertex-menton; 0.605 on
-//      the bundled head, whose landmarks the data README measures);
+//   3. face height H = (top - nose tip) / VERTEX_TO_NOSE (vertex-pronasale is ~0.6 of vertex-menton,
+//      measured along up);
 //   4. along the mid-line profile below the nose: the stomion is the crease (a valley at 1.2% H scale)
 //      nearest 0.145 H below the nose tip; the mouth corners end the lip crease traced sideways from it;
 //      above the nose: the nasion (deepest point) and the glabella (the brow bump above it).
@@ -16,6 +16,11 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+
+// Vertex to nose tip over vertex to menton, measured along up. The bundled head's menton is 4.75 units
+// below its vertex (data README); along the data's +Y the tip is 0.605 of it down, along the facial
+// frame rs_pack_orient finds (3 deg tilted back) 0.578, the value used: that frame is the default.
+#define VERTEX_TO_NOSE 0.578f
 
 rs_pack_axis rs_pack_axis_parse(const char *s)
 {
@@ -176,7 +181,9 @@ static void to_model(const rs_pack_face *f, float s, float u, float fw, float ou
 }
 
 // Everything past the frame: returns false when no face can be read (then the caller keeps defaults).
-static bool find_landmarks(const float (*pos)[3], uint32_t count, rs_pack_face *f, hmap *m, float *tmp)
+// H_fixed > 0 sets the face height instead of measuring it from the top of the scan (a face-only scan).
+static bool find_landmarks(const float (*pos)[3], const float (*normal)[3], uint32_t count, rs_pack_face *f, hmap *m,
+                           float *tmp, float H_fixed)
 {
     // Silhouette rows: width of the filled cells per row, top down.
     int top_row = -1;
@@ -254,9 +261,22 @@ static bool find_landmarks(const float (*pos)[3], uint32_t count, rs_pack_face *
     nose_s = dot3(pos[tip], f->side);
     nose_u = dot3(pos[tip], f->up);
 
-    float H = (top_u - nose_u) / 0.605f;
+    float H = H_fixed > 0 ? H_fixed : (top_u - nose_u) / VERTEX_TO_NOSE;
     if (!(H > 0.05f * h0) || !isfinite(H)) return false;  // a nose at the very top is no face
     f->face_height = H;
+    // Is the top of the scan the crown? On a whole head the highest points face up; a face-only scan
+    // ends in a cut across the forehead, whose points face forward.
+    if (normal) {
+        double up_sum = 0;
+        uint32_t up_n = 0;
+        for (uint32_t i = 0; i < count; i++)
+            if (dot3(pos[i], f->up) > top_u - 0.03f * H) up_sum += dot3(normal[i], f->up), up_n++;
+        f->crown = up_n && up_sum / up_n > 0.6;
+    } else {
+        f->crown = true;
+    }
+    // Without the crown the vertex is where it would be: VERTEX_TO_NOSE H above the nose tip.
+    if (H_fixed > 0) top_u = fmaxf(top_u, nose_u + VERTEX_TO_NOSE * H);
     to_model(f, nose_s, top_u, hm_at(m, nose_s, top_u - m->cell), f->top);
 
     // Mid-line profile landmarks.
@@ -390,12 +410,38 @@ static bool find_landmarks(const float (*pos)[3], uint32_t count, rs_pack_face *
 rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uint32_t count,
                             rs_pack_axis up, rs_pack_axis forward, rs_pack_face *out, rs_error *err)
 {
+    float u[3], fw[3];
+    axis_vector(up, RS_PACK_AXIS_POS_Y, u);
+    axis_vector(forward, RS_PACK_AXIS_POS_Z, fw);
+    if (fabsf(dot3(u, fw)) > 0.5f) return rs_fail(err, RS_ERR_ARG, "--up and --forward must be different axes");
+    if (up == RS_PACK_AXIS_DEFAULT && forward == RS_PACK_AXIS_DEFAULT) {
+        // No axes given: the frame comes from the scan itself, whatever its orientation (pack_frame.c);
+        // when no face can be read that way, the default axes frame the model.
+        bool found;
+        float ou[3], of[3], mid;
+        rs_result r = rs_pack_orient(pos, normal, count, ou, of, &mid, &found, err);
+        if (r != RS_OK) return r;
+        if (found) {
+            r = rs_pack_find_face_frame(pos, normal, count, ou, of, out, err);
+            if (r != RS_OK) return r;
+            if (out->found) {
+                // The orbit centre on the mirror plane, which the whole scan fixes better than the one
+                // nose-tip point the finder puts it through.
+                float off = dot3(out->centre, out->side) - mid;
+                for (int a = 0; a < 3; a++) out->centre[a] -= off * out->side[a];
+                return RS_OK;
+            }
+        }
+    }
+    return rs_pack_find_face_frame(pos, normal, count, u, fw, out, err);
+}
+
+rs_result rs_pack_find_face_frame(const float (*pos)[3], const float (*normal)[3], uint32_t count, const float up[3],
+                                  const float forward[3], rs_pack_face *out, rs_error *err)
+{
     rs_pack_face f = {0};
-    (void)normal;
-    axis_vector(up, RS_PACK_AXIS_POS_Y, f.up);
-    axis_vector(forward, RS_PACK_AXIS_POS_Z, f.forward);
-    if (fabsf(dot3(f.up, f.forward)) > 0.5f)
-        return rs_fail(err, RS_ERR_ARG, "--up and --forward must be different axes");
+    memcpy(f.up, up, sizeof f.up);
+    memcpy(f.forward, forward, sizeof f.forward);
     f.side[0] = f.up[1] * f.forward[2] - f.up[2] * f.forward[1];
     f.side[1] = f.up[2] * f.forward[0] - f.up[0] * f.forward[2];
     f.side[2] = f.up[0] * f.forward[1] - f.up[1] * f.forward[0];
@@ -486,9 +532,26 @@ rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uin
     hm_fill(&m, 1, tmp);
     hm_blur(&m, 1, tmp);
     rs_pack_face g = f;
-    if (find_landmarks(pos, count, &g, &m, tmp)) {
+    if (find_landmarks(pos, normal, count, &g, &m, tmp, 0)) {
         g.found = true;
         f = g;
+        // A face-only scan: the top is not the vertex, so the height measured from it is short. The lip
+        // line lies 0.142 H below the nose tip along up (the bundled head in its facial frame; adult
+        // norms, pronasale to stomion ~32-36 mm of ~225): H is the scale at which the landmarks found
+        // put the lips there. The mouth search itself scales with H, so iterate from 1.3 x the
+        // top-based height (a cut at the hairline loses ~0.25 H) until H settles.
+        float H = 1.3f * g.face_height;
+        for (int it = 0; !f.crown && it < 6; it++) {
+            rs_pack_face t = f;
+            if (!find_landmarks(pos, normal, count, &t, &m, tmp, H)) break;
+            float H_mouth = (dot3(t.nose_tip, t.up) - dot3(t.mouth, t.up)) / 0.142f;
+            t.found = true;
+            t.crown = false;
+            g = t;
+            if (!(H_mouth > 0) || !isfinite(H_mouth) || fabsf(H_mouth - H) < 0.01f * H) break;
+            H = fmaxf(H_mouth, f.face_height);
+        }
+        if (!f.crown) f = g;
     }
     free(m.f);
     free(tmp);
