@@ -91,7 +91,7 @@ expect env_tool_garbage_hdr 1 "bad_garbage.hdr" "$env_tool" "$fx/bad_garbage.hdr
 expect env_tool_not_2to1 1 "64x64 is not a latitude-longitude map" "$env_tool" "$fx/bad_ratio.hdr" -o "$tmp/b.rse" --name t
 expect env_tool_not_hdr 1 "neither OpenEXR nor Radiance" "$env_tool" "$fx/bad_not_hdr.png" -o "$tmp/b.rse" --name t
 expect env_tool_truncated_exr 1 "bad_truncated.exr: OpenEXR:" "$env_tool" "$fx/bad_truncated.exr" -o "$tmp/b.rse" --name t
-expect env_tool_huge_exr 1 "exceeds the maximum width" "$env_tool" "$fx/bad_huge.exr" -o "$tmp/b.rse" --name t
+expect env_tool_huge_exr 1 "too large (max 8192)" "$env_tool" "$fx/bad_huge.exr" -o "$tmp/b.rse" --name t
 expect env_tool_garbage_exr 1 "bad_garbage.exr: OpenEXR:" "$env_tool" "$fx/bad_garbage.exr" -o "$tmp/b.rse" --name t
 printf '' >"$tmp/empty.exr"
 expect env_tool_empty_file 1 "neither OpenEXR nor Radiance" "$env_tool" "$tmp/empty.exr" -o "$tmp/b.rse" --name t

@@ -307,7 +307,7 @@ bad_huge.hdr|at most 8192x4096|.hdr header claiming 200000x100000
 bad_garbage.hdr|not a readable Radiance|.hdr magic then garbage
 bad_ratio.hdr|not a latitude-longitude map|a 64x64 .hdr (not 2:1)
 bad_truncated.exr|OpenEXR:|.exr cut at 70%
-bad_huge.exr|exceeds the maximum width|.exr header claiming 200000x100000
+bad_huge.exr|too large (max 8192)|.exr header claiming 200000x100000
 bad_garbage.exr|OpenEXR:|.exr magic then garbage
 bad_not_hdr.png|neither OpenEXR nor Radiance|a PNG given as the capture
 EOF
@@ -327,6 +327,14 @@ for f in "$bad"/fuzz/rsf/*; do
     "$pack" --info "$f" >/dev/null 2>&1
     rc=$?
     if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_rsf_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_rsf_$b"; fi
+done
+for f in "$bad"/fuzz/envmap/*; do
+    [ -f "$f" ] || continue
+    b=$(basename "$f")
+    "$build/rouge-env" "$f" -o "$tmp/o.rse" --name x >/dev/null 2>&1
+    rc=$?
+    if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_envmap_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_envmap_$b"; fi
+    rm -f "$tmp/o.rse"
 done
 for kind in strokes look; do
     for f in "$bad/fuzz/$kind"/*; do

@@ -57,7 +57,8 @@ for t in $targets; do
         # rouge-env's readers: C parts compiled in, the OpenEXR C++ reader with clang++, linked as C++.
         cxx=${FUZZ_CXX:-clang++}
         # shellcheck disable=SC2046
-        "$cxx" -std=c++17 -g -O1 -Wall -Wextra -Werror -fsanitize=fuzzer-no-link $san $(pkg-config --cflags OpenEXR) \
+        "$cxx" -std=c++17 -g -O1 -Wall -Wextra -Werror -fsanitize=fuzzer-no-link $san \
+            $(pkg-config --cflags OpenEXR | sed "s/-I/-isystem /g") \
             -c tools/env/exr_read.cpp -o "$dir/exr_read.o" 2>"$dir/fuzz_$t.log" ||
             { cat "$dir/fuzz_$t.log" >&2; die "cannot build tools/env/exr_read.cpp"; }
         extra_c="tools/env/env_read.c tools/env/env_bake.c"

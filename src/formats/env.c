@@ -195,7 +195,7 @@ rs_result rs_env_load_memory(const void *data, size_t len, rs_env **out, rs_erro
         return rs_fail(err, RS_ERR_FORMAT, "%s: header size %u does not match the notes (byte %d)", what, header_size, OFF_HEADER_SIZE);
     uint32_t width = rs_le32_get(b + OFF_WIDTH), height = rs_le32_get(b + OFF_HEIGHT);
     uint32_t levels = rs_le32_get(b + OFF_LEVEL_COUNT);
-    if (width > RS_ENV_MAX_WIDTH || height * 2 != width || levels < 1 || levels > RS_ENV_MAX_LEVELS ||
+    if (width > RS_ENV_MAX_WIDTH || (uint64_t)height * 2 != width || levels < 1 || levels > RS_ENV_MAX_LEVELS ||
         !valid_size((int)width, (int)levels))
         return rs_fail(err, RS_ERR_FORMAT, "%s: a %ux%u map with %u levels is not a 2:1 map <= %d wide that halves evenly (byte %d)",
                        what, width, height, levels, RS_ENV_MAX_WIDTH, OFF_WIDTH);
@@ -214,6 +214,14 @@ rs_result rs_env_load_memory(const void *data, size_t len, rs_env **out, rs_erro
     rs_result r = rs_env_create((int)width, (int)levels, &e, err);
     if (r != RS_OK) return r;
     memcpy(e->name, b + OFF_NAME, sizeof e->name);
+    // Zero after the name's NUL, as the writer leaves it: one byte form per environment (save(load(f)) == f).
+    const char *nul = memchr(e->name, 0, sizeof e->name);
+    for (const char *p = nul ? nul : e->name + sizeof e->name; p < e->name + sizeof e->name; p++)
+        if (*p) {
+            rs_env_destroy(e);
+            return rs_fail(err, RS_ERR_FORMAT, "%s: name: bytes after its NUL must be 0 (byte %d)", what,
+                           OFF_NAME + (int)(p - e->name));
+        }
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++) e->sh[k][c] = rs_lef32_get(b + OFF_SH + 4 * (3 * k + c));
     for (int c = 0; c < 3; c++) {

@@ -101,12 +101,98 @@ static rs_result read_hdr(const uint8_t *data, size_t len, const char *name, int
 
 // ---- OpenEXR ----
 
+// OpenEXR's C++ library (which alone decodes DWA in 3.1) reads the attributes it knows by their structure
+// and an unknown one by allocating its claimed size: where a claimed size disagrees with the structure the
+// two parses part ways and a 300-byte file could make it allocate gigabytes (found by fuzz_envmap). So
+// every attribute is walked first: its size fits in the file, and for the types the C++ library parses
+// structurally the structure ends exactly at the claimed size. (exr_read.cpp then has OpenEXR's C core
+// check the header's values.)
+static bool exr_attr_consistent(const char *type, const uint8_t *v, size_t size)
+{
+    static const struct { const char *type; size_t size; } fixed[] = {
+        {"box2i", 16}, {"box2f", 16}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16}, {"v3i", 12}, {"v3f", 12}, {"v3d", 24},
+        {"int", 4}, {"float", 4}, {"double", 8}, {"compression", 1}, {"lineOrder", 1}, {"envmap", 1},
+        {"deepImageState", 1}, {"chromaticities", 32}, {"m33f", 36}, {"m44f", 64}, {"m33d", 72}, {"m44d", 128},
+        {"tiledesc", 9}, {"keycode", 28}, {"timecode", 8}, {"rational", 8},
+    };
+    for (size_t k = 0; k < RS_COUNT_OF(fixed); k++)
+        if (!strcmp(type, fixed[k].type)) return size == fixed[k].size;
+    if (!strcmp(type, "chlist")) {  // (name\0, 16 bytes)*, \0
+        size_t p = 0;
+        while (p < size && v[p]) {
+            const uint8_t *nul = memchr(v + p, 0, size - p);
+            if (!nul) return false;
+            p = (size_t)(nul - v) + 1;
+            if (size - p < 16) return false;
+            p += 16;
+        }
+        return p + 1 == size;
+    }
+    if (!strcmp(type, "preview")) {  // width, height, width * height * 4 bytes
+        if (size < 8) return false;
+        uint64_t w = rs_le32_get(v), h = rs_le32_get(v + 4);
+        return w * h * 4 + 8 == size;
+    }
+    if (!strcmp(type, "stringvector")) {  // (i32 length, bytes)*
+        size_t p = 0;
+        while (p < size) {
+            if (size - p < 4) return false;
+            int32_t n = (int32_t)rs_le32_get(v + p);
+            p += 4;
+            if (n < 0 || (size_t)n > size - p) return false;
+            p += (size_t)n;
+        }
+        return true;
+    }
+    return true;  // string, floatvector, opaque types: read by their claimed size
+}
+
+static rs_result exr_check_attributes(const uint8_t *b, size_t len, const char *name, rs_error *err)
+{
+    if (len < 8) return rs_fail(err, RS_ERR_FORMAT, "%s: OpenEXR: the file ends in its version field", name);
+    uint32_t version = rs_le32_get(b + 4);
+    bool multipart = version & 0x1000;
+    size_t pos = 8, max_name = version & 0x400 ? 255 : 31;
+    for (int part = 0;; part++) {
+        int attrs = 0;
+        for (;; attrs++) {
+            char tok[2][256];
+            for (int t = 0; t < 2; t++) {
+                size_t t0 = pos;
+                while (pos < len && b[pos] && pos - t0 < max_name) pos++;
+                if (pos >= len || b[pos])
+                    return rs_fail(err, RS_ERR_FORMAT, "%s: OpenEXR: header %d: attribute %s at byte %zu is cut or too long",
+                                   name, part, t ? "type" : "name", t0);
+                memcpy(tok[t], b + t0, pos - t0);
+                tok[t][pos - t0] = 0;
+                pos++;
+                if (t == 0 && !tok[0][0]) break;  // an empty name ends the header
+            }
+            if (!tok[0][0]) break;
+            if (len - pos < 4) return rs_fail(err, RS_ERR_FORMAT, "%s: OpenEXR: the header ends early (truncated)", name);
+            int32_t size = (int32_t)rs_le32_get(b + pos);
+            pos += 4;
+            if (size < 0 || (size_t)size > len - pos)
+                return rs_fail(err, RS_ERR_FORMAT, "%s: OpenEXR: attribute '%.40s' claims %d bytes, %zu remain (byte %zu)",
+                               name, tok[0], size, len - pos, pos - 4);
+            if (!exr_attr_consistent(tok[1], b + pos, (size_t)size))
+                return rs_fail(err, RS_ERR_FORMAT, "%s: OpenEXR: attribute '%.40s' (%.40s): %d bytes do not match its contents",
+                               name, tok[0], tok[1], size);
+            pos += (size_t)size;
+        }
+        if (!multipart || attrs == 0) break;  // a multipart file's headers end with an empty one
+    }
+    return RS_OK;
+}
+
 static rs_result read_exr(const uint8_t *data, size_t len, const char *name, int max_width, rs_envmap *out,
                           rs_error *err)
 {
     char msg[256] = "";
     int w = 0, h = 0;
     float *rgb = NULL;
+    rs_result cr = exr_check_attributes(data, len, name, err);
+    if (cr != RS_OK) return cr;
     int rc = rs_exr_read_memory(data, len, name, max_width, &w, &h, &rgb, msg, sizeof msg);
     if (rc == 2) {
         rs_result r = check_size(name, w, h, max_width, err);
