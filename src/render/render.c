@@ -703,7 +703,8 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
 
     GLint saved_viewport[4];
     glGetIntegerv(GL_VIEWPORT, saved_viewport);
-    if (r->have_frame && r->inc_valid && !r->time_stages && same_view(&f.view, &r->inc_view)) {
+    if (r->have_frame && r->inc_valid && !r->time_stages && same_view(&f.view, &r->inc_view) &&
+        !memcmp(r->inc_regions, r->cloud->hdr.regions, sizeof r->inc_regions)) {
         res = incremental_frame(r, &f, err);
         glDisable(GL_BLEND);
         glDisable(GL_DEPTH_TEST);
@@ -754,6 +755,7 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     r->inc_cam = f.cam;
     r->inc_count = f.count;
     r->inc_radius = r->cloud->hdr.radius_max * f.radius_scale * RS_COVERAGE;
+    memcpy(r->inc_regions, r->cloud->hdr.regions, sizeof r->inc_regions);
     clear_dirty(r);
     r->stats.splats_drawn = f.count;
     r->stats.face_pixels = f.face_px;

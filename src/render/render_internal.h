@@ -185,6 +185,7 @@ struct rs_renderer {
     rs_camera inc_cam;
     uint32_t inc_count;
     float inc_radius;           // the frame's largest drawn splat reach, model units
+    rs_region_info inc_regions[RS_SPLAT_MAX_REGIONS];  // the region table the frame used (callers may edit it)
     float dirty[4];             // x0, y0, x1, y1 in target pixels (GL, bottom-left origin); x0 > x1: none
     uint32_t inc_frames;        // incremental frames drawn (stats, tests)
 
