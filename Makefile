@@ -12,7 +12,7 @@
 
 BUILD    ?= build
 PREFIX   ?= /usr/local
-PKGS     := egl glesv2 glfw3 libpng cglm
+PKGS     := egl glesv2 glfw3 libpng cglm libzstd
 CC       ?= cc
 OPT      ?= -O2
 # Messages are cut to their buffers on purpose, so GCC's format-truncation guesses are not errors.
@@ -37,7 +37,7 @@ TESTS    := $(TEST_SRC:tests/%.c=$(BUILD)/tests/%)
 PROGS    := $(BUILD)/rouge $(TOOL_PROG:tools/rouge_%.c=$(BUILD)/rouge-%) $(BUILD)/rouge-env
 
 # The library needs no window system: GLFW is the app's.
-LIB_PKGS := egl glesv2 libpng cglm
+LIB_PKGS := egl glesv2 libpng cglm libzstd
 LIB_LIBS := $(shell pkg-config --libs $(LIB_PKGS) 2>/dev/null) -lm
 LIBS := $(BUILD)/librouge.a $(PKG_LIBS) -lm
 # Tests also link the app's parts (UI, viewer, CLI) through libapp.a; the converter's tests libpack.

@@ -743,6 +743,39 @@ static void test_convert_is_deterministic_and_decimates(void)
     rs_ply_destroy(m);
 }
 
+// Issue 14's goal: the 600k scan as rouge-pack writes it (version 2, 12-bit normals, 6-bit radii, ambient
+// occlusion in byte 15) in at most 8 bytes a splat, decoding to the very records converted.
+static void test_600k_scan_packs_to_at_most_8_bytes_per_splat(void)
+{
+    const char *path = rs_test_shared_path("leeperrysmith/head_points_600k.ply");
+    if (!path) {
+        rs_test_skip("shared data leeperrysmith/ not present");
+        return;
+    }
+    rs_ply_mesh *m = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_ply_load(path, &m, &err) == RS_OK, "%s", err.msg);
+    rs_splat_cloud *c = NULL, *d = NULL;
+    RS_REQUIRE(rs_pack_convert(m, &(rs_pack_desc){.mm_per_unit = 47}, &c, NULL, &err) == RS_OK, "%s", err.msg);
+    rs_ply_destroy(m);
+    bool lattice = true;
+    for (uint32_t i = 0; i < c->hdr.count; i++)
+        lattice &= (c->packed[i].w[2] & 0x000f000fu) == 0 && (c->packed[i].w[1] & 0x00030000u) == 0;
+    RS_CHECK(lattice, "normals / radii not on the %d / %d-bit lattices", RS_PACK_NORMAL_BITS, RS_PACK_RADIUS_BITS);
+    void *data = NULL;
+    size_t len = 0;
+    RS_REQUIRE(rs_splat_save_memory(c, &data, &len, &err) == RS_OK, "%s", err.msg);
+    double bps = (double)len / c->hdr.count;
+    printf("# 600k scan: %zu bytes, %.3f bytes/splat (.rsf v2)\n", len, bps);
+    RS_CHECK(bps <= 8.0, "%.3f bytes/splat, the goal is 8", bps);
+    RS_CHECK(rs_splat_load_memory(data, len, &d, &err) == RS_OK &&
+                 memcmp(c->packed, d->packed, (size_t)c->hdr.count * sizeof *c->packed) == 0,
+             "the file does not decode to the converted records: %s", err.msg);
+    free(data);
+    rs_splat_destroy(c);
+    rs_splat_destroy(d);
+}
+
 // ---- the bundled face ----
 
 // The splat nearest the line of sight through (x, y) from the front (+z), i.e. on the visible surface.
@@ -841,6 +874,7 @@ int main(int argc, char **argv)
     RS_RUN(test_degenerate_clouds_convert_without_crashing);
     RS_RUN(test_convert_rejects_bad_inputs_with_clear_errors);
     RS_RUN(test_convert_is_deterministic_and_decimates);
+    RS_RUN(test_600k_scan_packs_to_at_most_8_bytes_per_splat);
     RS_RUN(test_bundled_face_regions_are_where_they_belong);
     return rs_test_finish();
 }

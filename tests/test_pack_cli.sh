@@ -82,10 +82,24 @@ expect pack_info 0 "" "$pack" --info "$tmp/g.rsf"
 has pack_info_lists_lods "$tmp/out" "LOD prefixes"
 has pack_info_lists_regions "$tmp/out" "rho_s"
 has pack_info_lists_notes "$tmp/out" "converted by rouge-pack"
+has pack_writes_version_2 "$tmp/out" ".rsf version 2"
 head -c 300 "$tmp/g.rsf" >"$tmp/trunc.rsf"
 expect pack_info_truncated 1 "trunc.rsf" "$pack" --info "$tmp/trunc.rsf"
 expect pack_info_missing 1 "cannot open" "$pack" --info "$tmp/none.rsf"
 expect pack_info_with_input 2 "--info" "$pack" --info "$tmp/g.rsf" "$fx/points_le.ply"
+# An .rsf input is rewritten as it is: a version-1 file becomes version 2 with the same records and notes.
+expect pack_rewrites_v1_as_v2 0 "" "$pack" tests/fixtures/rsf/tiny_v1.rsf -o "$tmp/up.rsf" -q
+expect pack_info_rewritten 0 "" "$pack" --info "$tmp/up.rsf"
+has pack_rewritten_is_version_2 "$tmp/out" ".rsf version 2"
+has pack_rewritten_keeps_notes "$tmp/out" "rouge test fixture, no scan data"
+has pack_info_says_when_the_first_level_is_ready "$tmp/out" "first level   2 splats, drawable after"
+if cmp -s "$tmp/up.rsf" tests/fixtures/rsf/tiny_v2.rsf; then echo "ok - pack_rewrite_matches_tiny_v2"
+else echo "FAIL - pack_rewrite_matches_tiny_v2: $tmp/up.rsf differs from tests/fixtures/rsf/tiny_v2.rsf"; fi
+expect pack_rewrite_refuses_conversion_options 2 "conversion options do not apply" \
+    "$pack" tests/fixtures/rsf/tiny_v1.rsf -o "$tmp/up2.rsf" --points 5
+no_file pack_rewrite_refusal_leaves_no_output "$tmp/up2.rsf"
+expect pack_rewrite_of_a_damaged_rsf 1 "crc: stored" "$pack" tests/fixtures/rsf/bad_crc.rsf -o "$tmp/up3.rsf"
+no_file pack_rewrite_failure_leaves_no_output "$tmp/up3.rsf"
 
 # A PLY whose comment is Latin-1 and carries a bidi override converts (the note is made valid, terminal-safe
 # UTF-8), and --info prints it escaped: no raw override reaches the terminal.

@@ -92,7 +92,7 @@ while IFS='|' read -r file pat what; do
     bad_input "${file%.rsf}" ".rsf: $what" 1 "$pat" "$tmp/o.png" "$rouge" render "$bad/$file" -o "$tmp/o.png"
 done <<'EOF'
 rsf_wrong_magic.rsf|magic:|wrong magic "RSX\0"
-rsf_version_2.rsf|unsupported version 2|version 2
+rsf_version_9.rsf|unsupported version 9|version 9
 rsf_header_size_wrong.rsf|header_size:|header_size disagrees with notes_len
 rsf_flags_set.rsf|flags:|unknown flags set
 rsf_count_zero.rsf|count:|0 splats
@@ -113,6 +113,15 @@ rsf_notes_len_huge.rsf|notes_len:|notes_len 0xFFFFFFF0
 rsf_notes_bad_utf8.rsf|notes:|notes not UTF-8
 rsf_record_flags.rsf|splat 0:|ambient occlusion byte without the header flag
 rsf_trailing_bytes.rsf|after the CRC|16 bytes after the CRC
+EOF
+# ---- .rsf version 2 (tests/fixtures/bad/make_bad.py, from tests/fixtures/rsf/small_v2.rsf) ----
+while IFS='|' read -r file pat what; do
+    bad_input "${file%.rsf}" ".rsf v2: $what" 1 "$pat" "$tmp/o.png" "$rouge" render "$bad/$file" -o "$tmp/o.png"
+done <<'EOF'
+rsf2_truncated_chunk.rsf|chunk 2: file ends after 100 of its|file ends 100 bytes into chunk 2
+rsf2_bad_chunk_crc.rsf|chunk 1: crc: stored|one bit of chunk 1 flipped (its CRC kept)
+rsf2_bad_header_crc.rsf|header crc: stored|one bit of the header flipped (its CRC kept)
+rsf2_bomb.rsf|a decompression bomb?|a coded chunk claiming 1 Mi splats (16 MiB) from 512 bytes (header CRC recomputed)
 EOF
 bad_input rsf_bad_crc ".rsf: one payload bit flipped (CRC kept)" 1 "crc: stored" "$tmp/o.png" \
     "$rouge" render tests/fixtures/rsf/bad_crc.rsf -o "$tmp/o.png"

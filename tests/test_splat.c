@@ -15,6 +15,8 @@
 
 // ---- helpers ----
 
+static const rs_splat_save_desc V1 = {.version = 1};
+
 static uint64_t rng_state = 0x9e3779b97f4a7c15ull;
 
 static void rng_seed(uint64_t s) { rng_state = s * 0x9e3779b97f4a7c15ull + 1; }
@@ -84,8 +86,9 @@ static float get_f32(const uint8_t *b, size_t off)
 // Rewrites the trailing CRC so that a deliberately broken field is what the loader meets.
 static void fix_crc(uint8_t *b, size_t len) { put_u32(b, len - 4, rs_crc32(0, b, len - 4)); }
 
-// The small reference file of the malformed-input tests: 50 splats, LODs {50, 20, 5}, the default regions,
-// 10 bytes of notes -> header_size 608, records at 608..1407, CRC at 1408, 1412 bytes in all.
+// The small reference file of the malformed-input tests, in version 1 (tests/test_rsf2.c covers version
+// 2): 50 splats, LODs {50, 20, 5}, the default regions, 10 bytes of notes -> header_size 608, records at
+// 608..1407, CRC at 1408, 1412 bytes in all.
 enum { SMALL_N = 50, SMALL_HEADER = 608, SMALL_LEN = 1412 };
 
 static uint8_t *small_file(size_t *len)
@@ -96,7 +99,8 @@ static uint8_t *small_file(size_t *len)
     rs_error err = {0};
     rs_splat_cloud *c = NULL;
     void *data = NULL;
-    if (rs_splat_create(s, SMALL_N, &h, &c, &err) != RS_OK || rs_splat_save_memory(c, &data, len, &err) != RS_OK) {
+    if (rs_splat_create(s, SMALL_N, &h, &c, &err) != RS_OK ||
+        rs_splat_save_memory_with(c, &V1, &data, len, &err) != RS_OK) {
         fprintf(stderr, "small_file: %s\n", err.msg);
         abort();
     }
@@ -544,7 +548,7 @@ static void test_encoder_and_layout_match_the_v1_fixture(void)
     RS_REQUIRE(rs_splat_create(s, 4, &h, &c, &err) == RS_OK, "%s", err.msg);
     void *data;
     size_t len;
-    RS_REQUIRE(rs_splat_save_memory(c, &data, &len, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_splat_save_memory_with(c, &V1, &data, &len, &err) == RS_OK, "%s", err.msg);
     const char *path = "tests/fixtures/rsf/tiny_v1.rsf";
     const char *upd = getenv("RS_UPDATE_GOLDEN");
     if (upd && *upd == '1') RS_CHECK(rs_file_write_atomic(path, data, len, &err) == RS_OK, "%s", err.msg);
@@ -630,9 +634,9 @@ static void test_unsupported_version_is_named(void)
 {
     size_t len;
     uint8_t *b = small_file(&len);
-    put_u32(b, 4, 2);
+    put_u32(b, 4, 3);
     fix_crc(b, len);
-    expect_reject(b, len, RS_ERR_FORMAT, "unsupported version 2 (this build reads version 1)", "(byte 4)");
+    expect_reject(b, len, RS_ERR_FORMAT, "unsupported version 3 (this build reads versions 1 and 2)", "(byte 4)");
     put_u32(b, 4, 0);
     expect_reject(b, len, RS_ERR_FORMAT, "unsupported version 0", NULL);
     free(b);
@@ -864,7 +868,7 @@ static void test_random_damage_never_crashes_and_accepted_files_are_canonical(vo
         accepted++;
         void *q = NULL;
         size_t qlen = 0;
-        bool same = rs_splat_save_memory(c, &q, &qlen, &err) == RS_OK && qlen == len && memcmp(q, p, len) == 0;
+        bool same = rs_splat_save_memory_with(c, &V1, &q, &qlen, &err) == RS_OK && qlen == len && memcmp(q, p, len) == 0;
         free(q);
         rs_splat_destroy(c);
         if (!RS_CHECK(same, "trial %d: an accepted file does not re-save to the same bytes", trial)) break;

@@ -4,7 +4,8 @@
 #
 # Usage: sh tools/bench.sh [BUILD_DIR]       (run from the repository root; `make bench` does)
 # Environment: BENCH_QUICK=1 for a short run (fewer repetitions and views: about a minute on llvmpipe;
-# the full run takes a few minutes), RS_SHARED_DATA for the shared scans (default ../shared/data; rows
+# the full run takes a few minutes), BENCH_ONLY=size,load,rsf (a subset of the rows: size, convert, load,
+# rsf, stamp, memory, frames, env, paint, window), RS_SHARED_DATA for the shared scans (default ../shared/data; rows
 # that need them say "n/a (shared data absent)" without them), BENCH_FACE (default assets/face.rsf).
 # The table also goes to BUILD_DIR/bench.md.
 set -u
@@ -17,6 +18,8 @@ face=${BENCH_FACE:-assets/face.rsf}
 
 quick=""
 case "${BENCH_QUICK:-0}" in 0 | "") ;; *) quick=--quick ;; esac
+only=""
+[ -n "${BENCH_ONLY:-}" ] && only="--only $BENCH_ONLY"
 mkdir -p "$build/bench"
 
 # The window row (rouge view --bench-orbit) needs a display: without one, a private Xvfb if installed.
@@ -34,7 +37,7 @@ trap '[ -n "$xvfb" ] && kill "$xvfb" 2>/dev/null; wait 2>/dev/null' EXIT INT TER
 
 start=$(date +%s)
 # shellcheck disable=SC2086
-"$bench" --build "$build" --face "$face" --tmp "$build/bench" --out "$build/bench.md" $quick
+"$bench" --build "$build" --face "$face" --tmp "$build/bench" --out "$build/bench.md" $quick $only
 rc=$?
 echo
 echo "bench: $(($(date +%s) - start)) s${quick:+ (quick)}; table also in $build/bench.md"

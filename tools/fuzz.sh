@@ -5,7 +5,7 @@
 #
 #   harness                  parser                           seeds
 #   tools/fuzz/fuzz_ply.c    rs_ply_load_memory (tools/pack/ply.c)  tests/fixtures/ply
-#   tools/fuzz/fuzz_rsf.c    rs_splat_load_memory (src/splat)  tests/fixtures/rsf
+#   tools/fuzz/fuzz_rsf.c    rs_splat_load_memory + rs_splat_loader, v1 and v2 (src/splat)  tests/fixtures/rsf
 #   tools/fuzz/fuzz_strokes.c rs_strokes_parse (src/formats/strokes.c) tests/fixtures/strokes
 #   tools/fuzz/fuzz_look.c   rs_look_parse + apply (src/formats/look.c) tests/fixtures/looks
 #   tools/fuzz/fuzz_convert.c PLY -> convert -> preview -> save/load  tests/fixtures/ply + bad/ply_*
@@ -48,7 +48,7 @@ make --no-print-directory -s BUILD="$dir/lib" CC="$cc" OPT=-O1 \
     EXTRA_CFLAGS="-Wno-unknown-warning-option -fsanitize=fuzzer-no-link $san" \
     "$dir/lib/librouge.a" "$dir/lib/libpack.a" >"$dir/build.log" 2>&1 ||
     { tail -n 20 "$dir/build.log" >&2; die "library build failed (log: $dir/build.log)"; }
-pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm 2>/dev/null)
+pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm libzstd 2>/dev/null)
 for t in $targets; do
     src="tools/fuzz/fuzz_$t.c"
     [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert env envmap)"

@@ -3,6 +3,8 @@
 //
 // Rows: machine and GL renderer; file bytes per splat (ours vs the float PLY's); conversion time of the
 // 600k scan and of the textured mesh (rouge-pack run as a child process); load time of the 600k face;
+// .rsf version 2: bytes per splat of the converted 600k scan, decode time against version 1's, time to
+// the first LOD level through the progressive loader;
 // brush stamp cost for sizes 0.1/0.2/0.3; bare / reference / mobile frame times at 512x512 and 1280x720
 // and their ratios; mobile-vs-reference PSNR/SSIM/CIEDE2000 over 8 views x 2 lights in the diffuse and
 // full modes; peak CPU memory; GPU bytes per splat; the window's frame time while orbiting.
@@ -11,6 +13,7 @@
 // A row whose input or program is missing says "n/a (why)" and the rest still runs.
 //
 //   build/rouge-bench --build build [--data ../shared/data] [--quick] [--face assets/face.rsf]
+//                     [--only size,convert,load,rsf,stamp,memory,frames,env,paint,window]   (a subset of the rows)
 #define _DEFAULT_SOURCE  // wait4 (per-child peak memory)
 
 #include "formats/env_lookup.h"
@@ -43,8 +46,8 @@ typedef struct row {
 
 typedef struct bench {
     const char *build, *data, *face, *tmp;
+    const char *only;           // comma-separated row groups, NULL for all
     bool quick;
-    const char *only;           // --only paint|env: just those rows
     int frames;                 // per frame-time configuration
     row rows[MAX_ROWS];
     int row_count;
@@ -74,6 +77,19 @@ static void progress(const char *fmt, ...)
     vfprintf(stderr, fmt, ap);
     fputc('\n', stderr);
     va_end(ap);
+}
+
+// Whether a row group runs: all of them unless --only names some.
+static bool wanted(const bench *b, const char *group)
+{
+    if (!b->only) return true;
+    size_t n = strlen(group);
+    for (const char *p = b->only; *p;) {
+        size_t len = strcspn(p, ",");
+        if (len == n && strncmp(p, group, n) == 0) return true;
+        p += len + (p[len] == ',');
+    }
+    return false;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -202,9 +218,18 @@ static void size_rows(bench *b, const char *ply)
 {
     long long bytes = file_size(b->face);
     uint32_t n = b->cloud->hdr.count;
-    double header = (double)bytes - 16.0 * n - 4.0;
+    unsigned char head[8] = {0};
+    FILE *f = fopen(b->face, "rb");
+    if (f) {
+        if (fread(head, 1, sizeof head, f) != sizeof head) head[4] = 0;
+        fclose(f);
+    }
     char notes[320];
-    snprintf(notes, sizeof notes, "16 B records + %.0f B header/notes/CRC; goal <= 16 B (issue 3)", header);
+    if (head[4] == 1)
+        snprintf(notes, sizeof notes, ".rsf version 1: 16 B records + %.0f B header/notes/CRC", (double)bytes - 16.0 * n - 4.0);
+    else
+        snprintf(notes, sizeof notes, ".rsf version %u: entropy-coded chunks, coarsest LOD level first; goal <= 8 B "
+                 "(issue 14)", head[4]);
     add_row(b, "file bytes/splat: ours (.rsf)", notes, "%.2f B (%s: %lld B, %u splats)", (double)bytes / n,
             b->face, bytes, n);
     unsigned long pn = ply ? ply_vertex_count(ply) : 0;
@@ -297,6 +322,129 @@ static void load_row(bench *b)
     snprintf(notes, sizeof notes, "rs_splat_load: read, CRC, validate, decode; median of %d (file in page cache)",
              runs);
     add_row(b, what, notes, "%.1f ms", median(ms, runs));
+}
+
+// ---- .rsf version 2 ----
+
+// Writes `c` as `version` to path; false (and a row saying why) on failure.
+static bool write_version(bench *b, const rs_splat_cloud *c, uint32_t version, const char *path)
+{
+    rs_error err = {0};
+    if (rs_splat_save_with(c, path, &(rs_splat_save_desc){.version = version}, &err) == RS_OK) return true;
+    add_row(b, "rsf v2", NULL, "n/a (%s)", err.msg);
+    return false;
+}
+
+// Median ms of rs_splat_load (file in the page cache) or, with `memory`, rs_splat_load_memory.
+static double time_load(const char *path, bool memory, int runs)
+{
+    void *data = NULL;
+    size_t len = 0;
+    rs_error err = {0};
+    if (memory && rs_file_read_all(path, (size_t)1 << 31, &data, &len, &err) != RS_OK) return NAN;
+    double ms[64];
+    runs = RS_MIN(runs, 64);
+    for (int i = 0; i < runs; i++) {
+        rs_splat_cloud *c = NULL;
+        double t0 = rs_time_now();
+        rs_result r = memory ? rs_splat_load_memory(data, len, &c, &err) : rs_splat_load(path, &c, &err);
+        ms[i] = (rs_time_now() - t0) * 1000.0;
+        rs_splat_destroy(c);
+        if (r != RS_OK) {
+            free(data);
+            return NAN;
+        }
+    }
+    free(data);
+    return median(ms, runs);
+}
+
+// Time from opening the file until the coarsest LOD level is decoded and a preview cloud of it exists
+// (what a viewer needs before its first frame), reading 64 KiB at a time; and that level's size.
+static double time_first_level(const char *path, uint32_t *level, size_t *bytes_read)
+{
+    double t0 = rs_time_now();
+    int fd = open(path, O_RDONLY);
+    if (fd < 0) return NAN;
+    rs_splat_loader *l = NULL;
+    rs_error err = {0};
+    rs_splat_cloud *p = NULL;
+    static unsigned char buf[65536];
+    size_t got = 0;
+    if (rs_splat_loader_create(&(rs_splat_loader_desc){.name = path}, &l, &err) == RS_OK) {
+        ssize_t n;
+        while (!p && (n = read(fd, buf, sizeof buf)) > 0) {
+            got += (size_t)n;
+            if (rs_splat_loader_feed(l, buf, (size_t)n, &err) != RS_OK) break;
+            uint32_t ready = rs_splat_loader_ready(l);
+            if (ready && rs_splat_loader_preview(l, ready, &p, &err) == RS_OK) *level = ready;
+        }
+    }
+    double t = rs_time_now() - t0;
+    close(fd);
+    rs_splat_loader_destroy(l);
+    bool ok = p != NULL;
+    rs_splat_destroy(p);
+    *bytes_read = got;
+    return ok ? t * 1000.0 : NAN;
+}
+
+static void rsf_rows(bench *b, const char *ply)
+{
+    char pack[512], out[512], v1[512], v2[512], notes[320];
+    snprintf(pack, sizeof pack, "%s/rouge-pack", b->build);
+    snprintf(out, sizeof out, "%s/rsf2_600k.rsf", b->tmp);
+    if (!ply || !file_exists(pack)) {
+        add_row(b, "file bytes/splat: rouge-pack 600k scan", NULL, "n/a (%s)", ply ? "rouge-pack not built" : "shared data absent");
+    } else {
+        progress("converting the 600k point cloud for the .rsf v2 rows");
+        char *argv[] = {pack, (char *)ply, "-o", out, "-q", NULL};
+        child_result c = run_child(argv, NULL, 300);
+        long long bytes = file_size(out);
+        if (!c.ran || c.status != 0 || bytes <= 0) {
+            add_row(b, "file bytes/splat: rouge-pack 600k scan", NULL, "n/a (rouge-pack failed: exit %d)", c.status);
+        } else {
+            snprintf(notes, sizeof notes, ".rsf v2 as rouge-pack writes it (12-bit normals, 6-bit radii, AO, zstd level 17); "
+                     "version 1: 16 B; goal <= 8 B (issue 14)");
+            add_row(b, "file bytes/splat: rouge-pack 600k scan (.rsf v2)", notes, "%.2f B (%lld B)",
+                    (double)bytes / 600000.0, bytes);
+        }
+        unlink(out);
+    }
+    // Decode and load: the bench face written both ways, timed in the same run.
+    snprintf(v1, sizeof v1, "%s/face_v1.rsf", b->tmp);
+    snprintf(v2, sizeof v2, "%s/face_v2.rsf", b->tmp);
+    if (!write_version(b, b->cloud, 1, v1) || !write_version(b, b->cloud, 2, v2)) return;
+    int runs = b->quick ? 7 : 31;
+    progress(".rsf v1 / v2 decode and load");
+    double m1 = time_load(v1, true, runs), m2 = time_load(v2, true, runs);
+    double f1 = time_load(v1, false, runs), f2 = time_load(v2, false, runs);
+    uint32_t n = b->cloud->hdr.count;
+    snprintf(notes, sizeof notes, "rs_splat_load_memory, median of %d: CRCs, zstd, inverse transform, checks, float "
+             "decode; version 1 (no entropy decode): %.1f ms; ratio %.2f", runs, m1, m2 / m1);
+    add_row(b, "decode .rsf v2 (in memory)", notes, "%.1f ms (%uk splats, %.2f B/splat)", m2, (n + 500) / 1000,
+            (double)file_size(v2) / n);
+    snprintf(notes, sizeof notes, "rs_splat_load of the same face, file in page cache, median of %d; version 1: "
+             "%.1f ms; ratio %.2f (goal <= 1.5)", runs, f1, f2 / f1);
+    add_row(b, "load .rsf v2 file", notes, "%.1f ms", f2);
+    double first[64];
+    uint32_t level = 0;
+    size_t read_bytes = 0;
+    int k = 0;
+    for (int i = 0; i < runs; i++) {
+        double t = time_first_level(v2, &level, &read_bytes);
+        if (t == t) first[k++] = t;
+    }
+    if (!k) {
+        add_row(b, "time to first LOD level (.rsf v2)", NULL, "n/a (the loader failed)");
+    } else {
+        snprintf(notes, sizeof notes, "rs_splat_loader fed 64 KiB reads until the coarsest level (%u splats) is "
+                 "decoded and a preview cloud made; %zu of %lld bytes read; median of %d", level, read_bytes,
+                 file_size(v2), k);
+        add_row(b, "time to first LOD level (.rsf v2)", notes, "%.2f ms", median(first, k));
+    }
+    unlink(v1);
+    unlink(v2);
 }
 
 // ---- brush stamps ----
@@ -811,7 +959,8 @@ static void print_table(const bench *b, FILE *f)
 static int usage(void)
 {
     fprintf(stderr, "usage: rouge-bench --build DIR [--data DIR] [--face FILE.rsf] [--tmp DIR] [--quick] "
-                    "[--only paint|env] [--out FILE.md]\n");
+                    "[--out FILE.md]\n"
+                    "                   [--only size,convert,load,rsf,stamp,memory,frames,env,paint,window]\n");
     return 2;
 }
 
@@ -826,13 +975,13 @@ int main(int argc, char **argv)
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--quick")) b->quick = true;
-        else if (!strcmp(a, "--only") && v && (!strcmp(v, "paint") || !strcmp(v, "env"))) b->only = v, i++;
         else if (!v) return usage();
         else if (!strcmp(a, "--build")) b->build = v, i++;
         else if (!strcmp(a, "--data")) b->data = v, i++;
         else if (!strcmp(a, "--face")) b->face = v, i++;
         else if (!strcmp(a, "--tmp")) b->tmp = v, i++;
         else if (!strcmp(a, "--out")) out_md = v, i++;
+        else if (!strcmp(a, "--only")) b->only = v, i++;
         else return usage();
     }
     char tmp[512];
@@ -852,56 +1001,57 @@ int main(int argc, char **argv)
     snprintf(ply_path, sizeof ply_path, "%s/leeperrysmith/head_points_600k.ply", b->data);
     const char *ply = file_exists(ply_path) ? ply_path : NULL;
 
-    if (b->only) {
-        rs_gl_context *gl = NULL;
-        if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
-            fprintf(stderr, "rouge-bench: %s\n", err.msg);
-            return 1;
-        }
-        add_row(b, "GL renderer", NULL, "%s", rs_gl_get_caps(gl)->renderer);
-        if (!strcmp(b->only, "paint")) paint_row(b, gl);
-        else env_row(b, gl);
-        rs_gl_destroy(gl);
-        print_table(b, stdout);
-        rs_splat_destroy(b->cloud);
-        free(b);
-        return 0;
-    }
     machine_rows(b);
-    int gl_row = b->row_count;
-    add_row(b, "GL renderer", NULL, "n/a");  // filled in once the context exists
-    size_rows(b, ply);
-    convert_rows(b, ply);
-    load_row(b);
-    progress("brush stamps");
-    stamp_rows(b);
-    progress("peak memory");
-    memory_row(b);  // before this process has a GL context (fork)
-
-    rs_gl_context *gl = NULL;
-    rs_renderer *r = NULL;
-    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK ||
-        rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r, &err) != RS_OK) {
-        snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "n/a (%s)", err.msg);
-        add_row(b, "frame times, quality, GPU bytes", NULL, "n/a (no GLES 3 context)");
-    } else {
-        const rs_gl_caps *caps = rs_gl_get_caps(gl);
-        snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "%s", caps->renderer);
-        snprintf(b->rows[gl_row].notes, sizeof b->rows[gl_row].notes, "%s, %s; float targets %s",
-                 caps->platform, caps->version, caps->float_rt ? "yes" : "no");
-        frame_rows(b, gl);
-        progress("environment cost");
-        env_row(b, gl);
-        progress("paint frames");
-        paint_row(b, gl);
-        progress("per-stage timings");
-        stage_rows(b, gl);
-        quality_rows(b, r);
-        gpu_row(b, r);
+    int gl_row = -1;
+    bool gl_rows = wanted(b, "frames") || wanted(b, "env") || wanted(b, "paint");
+    if (gl_rows) {
+        gl_row = b->row_count;
+        add_row(b, "GL renderer", NULL, "n/a");  // filled in once the context exists
     }
-    rs_render_destroy(r);
-    rs_gl_destroy(gl);
-    window_row(b);
+    if (wanted(b, "size")) size_rows(b, ply);
+    if (wanted(b, "convert")) convert_rows(b, ply);
+    if (wanted(b, "load")) load_row(b);
+    if (wanted(b, "rsf")) rsf_rows(b, ply);
+    if (wanted(b, "stamp")) {
+        progress("brush stamps");
+        stamp_rows(b);
+    }
+    if (wanted(b, "memory")) {
+        progress("peak memory");
+        memory_row(b);  // before this process has a GL context (fork)
+    }
+    if (gl_rows) {
+        rs_gl_context *gl = NULL;
+        rs_renderer *r = NULL;
+        if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK ||
+            rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r, &err) != RS_OK) {
+            snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "n/a (%s)", err.msg);
+            add_row(b, "frame times, quality, GPU bytes", NULL, "n/a (no GLES 3 context)");
+        } else {
+            const rs_gl_caps *caps = rs_gl_get_caps(gl);
+            snprintf(b->rows[gl_row].value, sizeof b->rows[gl_row].value, "%s", caps->renderer);
+            snprintf(b->rows[gl_row].notes, sizeof b->rows[gl_row].notes, "%s, %s; float targets %s",
+                     caps->platform, caps->version, caps->float_rt ? "yes" : "no");
+            if (wanted(b, "frames")) frame_rows(b, gl);
+            if (wanted(b, "env")) {
+                progress("environment cost");
+                env_row(b, gl);
+            }
+            if (wanted(b, "paint")) {
+                progress("paint frames");
+                paint_row(b, gl);
+            }
+            if (wanted(b, "frames")) {
+                progress("per-stage timings");
+                stage_rows(b, gl);
+                quality_rows(b, r);
+                gpu_row(b, r);
+            }
+        }
+        rs_render_destroy(r);
+        rs_gl_destroy(gl);
+    }
+    if (wanted(b, "window")) window_row(b);
 
     print_table(b, stdout);
     if (out_md) {

@@ -13,14 +13,17 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 static const char usage[] =
     "usage: rouge-pack INPUT -o OUT.rsf [options]\n"
     "       rouge-pack --info FILE.rsf [--preview PNG]\n"
+    "       rouge-pack OLD.rsf -o NEW.rsf    (rewrites an .rsf as version 2, records and notes as they are)\n"
     "\n"
-    "Converts a scan into rouge's compact splat file (.rsf, 16 bytes per splat): normals (estimated\n"
+    "Converts a scan into rouge's compact splat file (.rsf version 2: about 8 bytes per splat, entropy-\n"
+    "coded, the coarsest LOD level first so viewers can show it while the rest loads): normals (estimated\n"
     "by k-nearest-neighbour PCA when the input has none), a radius per splat from the local spacing, LOD\n"
     "order (every prefix in the LOD table is an even subsample), and face regions for the skin BRDF.\n"
     "\n"
@@ -134,6 +137,41 @@ static void show_progress(void *user, rs_pack_step step, double f)
 
 // ---- --info ----
 
+// How many bytes of the file a progressive reader needs before the coarsest LOD level can be drawn:
+// the file fed to rs_splat_loader byte by byte (0 for a version-1 file, which decodes only whole).
+static uint64_t first_level_bytes(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    rs_splat_loader *l = NULL;
+    if (!f || rs_splat_loader_create(&(rs_splat_loader_desc){.name = path}, &l, NULL) != RS_OK) {
+        if (f) fclose(f);
+        return 0;
+    }
+    uint64_t at = 0, found = 0;
+    int ch;
+    while (!found && (ch = fgetc(f)) != EOF) {
+        unsigned char b = (unsigned char)ch;
+        if (rs_splat_loader_feed(l, &b, 1, NULL) != RS_OK) break;
+        at++;
+        if (rs_splat_loader_ready(l)) found = at;
+    }
+    fclose(f);
+    rs_splat_loader_destroy(l);
+    return found;
+}
+
+// The version field of a file that has just loaded (bytes 4..7, little-endian).
+static unsigned file_version(const char *path)
+{
+    unsigned char b[8] = {0};
+    FILE *f = fopen(path, "rb");
+    if (f) {
+        if (fread(b, 1, sizeof b, f) != sizeof b) memset(b, 0, sizeof b);
+        fclose(f);
+    }
+    return (unsigned)b[4] | (unsigned)b[5] << 8 | (unsigned)b[6] << 16 | (unsigned)b[7] << 24;
+}
+
 static int info(const char *path, const char *preview)
 {
     rs_error err = {0};
@@ -143,7 +181,12 @@ static int info(const char *path, const char *preview)
     long long size = file_size(path);
     printf("%s\n", path);
     printf("  splats        %u\n", h->count);
-    printf("  file size     %lld bytes (%.2f bytes/splat)\n", size, h->count ? (double)size / h->count : 0.0);
+    printf("  file size     %lld bytes (%.2f bytes/splat, .rsf version %u)\n", size,
+           h->count ? (double)size / h->count : 0.0, file_version(path));
+    uint64_t first = first_level_bytes(path);
+    if (first)
+        printf("  first level   %u splats, drawable after %llu bytes (%.1f%% of the file)\n", h->lods[h->lod_count - 1],
+               (unsigned long long)first, 100.0 * (double)first / (double)size);
     printf("  bbox          (%.4f %.4f %.4f) .. (%.4f %.4f %.4f) units\n", h->bbox_min[0], h->bbox_min[1],
            h->bbox_min[2], h->bbox_max[0], h->bbox_max[1], h->bbox_max[2]);
     printf("  radius        %.5f .. %.5f units (%.3f .. %.3f mm)\n", h->radius_min, h->radius_max,
@@ -183,6 +226,37 @@ static int info(const char *path, const char *preview)
     }
     rs_splat_destroy(c);
     return rc;
+}
+
+// ---- an .rsf rewritten in the newest version ----
+
+// A regular file that starts with the .rsf magic (O_NONBLOCK: a FIFO must not block here; the
+// converter's reader refuses anything that is not a regular file).
+static bool is_rsf(const char *path)
+{
+    unsigned char b[4] = {0};
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0) return false;
+    struct stat st;
+    bool yes = fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && read(fd, b, 4) == 4 && memcmp(b, "RSF\0", 4) == 0;
+    close(fd);
+    return yes;
+}
+
+// The records, LOD order, regions and notes as they are: how a version-1 file becomes a version-2 one.
+static int rewrite(const char *in, const char *out, bool quiet)
+{
+    rs_error err = {0};
+    rs_splat_cloud *c = NULL;
+    if (rs_splat_load(in, &c, &err) != RS_OK) return fail(1, "%s", err.msg);
+    rs_result r = rs_splat_save(c, out, &err);
+    uint32_t n = c->hdr.count;
+    rs_splat_destroy(c);
+    if (r != RS_OK) return fail(1, "%s", err.msg);
+    if (!quiet)
+        printf("rouge-pack: %s -> %s: %u splats rewritten as .rsf version 2, %.2f bytes/splat (was %.2f)\n", in, out, n,
+               (double)file_size(out) / n, (double)file_size(in) / n);
+    return 0;
 }
 
 // ---- conversion ----
@@ -454,5 +528,11 @@ int main(int argc, char **argv)
     rs_pack_axis up = o.desc.up ? o.desc.up : RS_PACK_AXIS_POS_Y, fwd = o.desc.forward ? o.desc.forward : RS_PACK_AXIS_POS_Z;
     if ((up - 1) / 2 == (fwd - 1) / 2) return fail(2, "--up and --forward must be different axes");
     if (!o.output) return fail(2, "no output: give -o OUT.rsf");
+    if (is_rsf(o.input)) {
+        static const rs_pack_desc none;
+        if (memcmp(&o.desc, &none, sizeof none) != 0 || o.preview || o.maps[0] || o.maps[1] || o.maps[2] || o.maps[3])
+            return fail(2, "%s is an .rsf file: it is rewritten as it is, conversion options do not apply", o.input);
+        return rewrite(o.input, o.output, o.quiet);
+    }
     return convert(&o);
 }

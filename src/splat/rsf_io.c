@@ -1,5 +1,6 @@
-// rsf_io.c — the .rsf file: explicit little-endian bytes, CRC-32, a loader that trusts nothing.
-// Layout and rules: docs/rsf.md. Offsets: splat_internal.h.
+// rsf_io.c — the .rsf file: explicit little-endian bytes, CRC-32, a loader that trusts nothing. Version 1
+// (one 16-byte record per splat) is read and written here; load and save dispatch to rsf_v2.c for
+// version 2. Layout and rules: docs/rsf.md. Offsets: splat_internal.h.
 #define _POSIX_C_SOURCE 200809L  // strnlen
 #include "splat_internal.h"
 
@@ -9,10 +10,9 @@
 
 static const uint8_t rsf_magic[4] = {'R', 'S', 'F', 0};
 
-// A whole .rsf: fixed header, largest notes, padding, the most records allowed, CRC.
-#define RSF_MAX_FILE_BYTES \
-    ((size_t)RSF_OFF_NOTES + RS_SPLAT_MAX_NOTES + RSF_PAYLOAD_ALIGN + (size_t)RS_SPLAT_MAX_COUNT * RSF_RECORD_SIZE + \
-     RSF_CRC_SIZE)
+// The largest file read: a v2 file is never larger than a v1 file plus its chunk table (a chunk never
+// outgrows its records stored raw).
+#define RSF_MAX_FILE_BYTES (RSF_MAX_FILE_BYTES_V1 + RSF2_MAX_HEADER)
 
 // CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320), as zlib's crc32(): the table is crc of each byte.
 static const uint32_t crc_table[256] = {
@@ -61,7 +61,7 @@ static const uint32_t crc_table[256] = {
     0xb40bbe37u, 0xc30c8ea1u, 0x5a05df1bu, 0x2d02ef8du,
 };
 
-static uint32_t rd_u32(const uint8_t *p);
+static uint32_t rd_u32(const uint8_t *p) { return rsf_rd_u32(p); }
 
 // Large buffers go 8 bytes per step ("slicing-by-8", Kounavis & Berry 2005): t[k][b] is the CRC of byte b
 // followed by k zero bytes. The tables take ~2 us to build, so they live on the stack, not in a global.
@@ -91,11 +91,6 @@ uint32_t rs_crc32(uint32_t crc, const void *data, size_t len)
 
 // ---- little-endian fields, independent of the host ----
 
-static uint32_t rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
 static float rd_f32(const uint8_t *p)
 {
     uint32_t u = rd_u32(p);
@@ -104,13 +99,7 @@ static float rd_f32(const uint8_t *p)
     return f;
 }
 
-static void wr_u32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
+static void wr_u32(uint8_t *p, uint32_t v) { rsf_wr_u32(p, v); }
 
 static void wr_f32(uint8_t *p, float f)
 {
@@ -129,13 +118,10 @@ static void wr_vec3(uint8_t *b, size_t off, const float v[3])
     for (int a = 0; a < 3; a++) wr_f32(b + off + 4 * (size_t)a, v[a]);
 }
 
-static size_t header_size_for(size_t notes_len)
-{
-    return (RSF_OFF_NOTES + notes_len + RSF_PAYLOAD_ALIGN - 1) / RSF_PAYLOAD_ALIGN * RSF_PAYLOAD_ALIGN;
-}
+static size_t header_size_for(size_t notes_len) { return rsf_align16(RSF_OFF_NOTES + notes_len); }
 
 // The fixed part of the header (bytes 0..587), field by field; the caller checked len >= RSF_OFF_NOTES.
-static void read_fixed_header(const uint8_t *b, rs_splat_header *h)
+void rs_rsf_read_fixed_header(const uint8_t *b, rs_splat_header *h)
 {
     memset(h, 0, sizeof *h);
     h->flags = rd_u32(b + RSF_OFF_FLAGS);
@@ -160,10 +146,12 @@ static void read_fixed_header(const uint8_t *b, rs_splat_header *h)
     }
 }
 
-static void write_header(uint8_t *b, const rs_splat_header *h, size_t notes_len, size_t header_size)
+// Bytes 0..587 and the notes; `b` is zeroed (unused slots stay 0: one canonical byte form per cloud).
+void rs_rsf_write_fixed_header(uint8_t *b, const rs_splat_header *h, uint32_t version, size_t notes_len,
+                               size_t header_size)
 {
     memcpy(b + RSF_OFF_MAGIC, rsf_magic, sizeof rsf_magic);
-    wr_u32(b + RSF_OFF_VERSION, RSF_VERSION);
+    wr_u32(b + RSF_OFF_VERSION, version);
     wr_u32(b + RSF_OFF_HEADER_SIZE, (uint32_t)header_size);
     wr_u32(b + RSF_OFF_FLAGS, h->flags);
     wr_u32(b + RSF_OFF_COUNT, h->count);
@@ -207,10 +195,10 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
     if (len < RSF_OFF_VERSION + 4)
         return rs_fail(err, RS_ERR_FORMAT, "%s: version: file ends inside the header (byte %zu)", name, len);
     uint32_t version = rd_u32(b + RSF_OFF_VERSION);
-    if (version != RSF_VERSION)
+    if (version != RSF_VERSION_1)
         return rs_fail(err, RS_ERR_FORMAT,
-                       "%s: version: unsupported version %u (this build reads version %d) (byte %d)", name, version,
-                       RSF_VERSION, RSF_OFF_VERSION);
+                       "%s: version: unsupported version %u (this build reads versions 1 and 2) (byte %d)", name,
+                       version, RSF_OFF_VERSION);
     if (len < RSF_OFF_NOTES)
         return rs_fail(err, RS_ERR_FORMAT,
                        "%s: header: file is %zu bytes, ends inside the %d-byte fixed header (byte %zu)", name, len,
@@ -260,13 +248,13 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
     for (size_t i = RSF_OFF_NOTES + notes_len; i < header_size; i++)
         if (b[i] != 0) return rs_fail(err, RS_ERR_FORMAT, "%s: padding: must be 0 (byte %zu)", name, i);
 
-    read_fixed_header(b, h);
+    rs_rsf_read_fixed_header(b, h);
     memcpy(h->notes, b + RSF_OFF_NOTES, notes_len);
     *payload_off = header_size;
     return RS_OK;
 }
 
-static rs_result load_bytes(const uint8_t *b, size_t len, const char *name, rs_splat_cloud **out, rs_error *err)
+rs_result rs_rsf1_load(const uint8_t *b, size_t len, const char *name, rs_splat_cloud **out, rs_error *err)
 {
     rs_splat_header *h = malloc(sizeof *h);
     if (!h) return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory", name);
@@ -294,6 +282,16 @@ static rs_result load_bytes(const uint8_t *b, size_t len, const char *name, rs_s
     return RS_OK;
 }
 
+// Version 2 goes to rsf_v2.c; everything else to the version-1 loader, which names a wrong magic or an
+// unknown version.
+static rs_result load_bytes(const uint8_t *b, size_t len, const char *name, rs_splat_cloud **out, rs_error *err)
+{
+    if (len >= RSF_OFF_VERSION + 4 && memcmp(b, rsf_magic, sizeof rsf_magic) == 0 &&
+        rd_u32(b + RSF_OFF_VERSION) == RSF_VERSION_2)
+        return rs_rsf2_load(b, len, name, out, err);
+    return rs_rsf1_load(b, len, name, out, err);
+}
+
 rs_result rs_splat_load_memory(const void *data, size_t len, rs_splat_cloud **out, rs_error *err)
 {
     assert(out && (data || len == 0));
@@ -315,8 +313,7 @@ rs_result rs_splat_load(const char *path, rs_splat_cloud **out, rs_error *err)
 
 // ---- save ----
 
-static rs_result encode_file(const rs_splat_cloud *c, const char *name, void **out_data, size_t *out_len,
-                             rs_error *err)
+rs_result rs_rsf_check_for_save(const rs_splat_cloud *c, const char *name, rs_error *err)
 {
     const rs_splat_header *h = &c->hdr;
     // The cloud may have been edited since create/load: write only what a loader would accept.
@@ -328,11 +325,20 @@ static rs_result encode_file(const rs_splat_cloud *c, const char *name, void **o
             return rs_fail(err, RS_ERR_ARG, "%s: splat %u: region %u / flags 0x%02x out of range", name, i, w[1] >> 24,
                            w[3] >> 24);
     }
+    return RS_OK;
+}
+
+static rs_result encode_v1(const rs_splat_cloud *c, const char *name, void **out_data, size_t *out_len,
+                           rs_error *err)
+{
+    const rs_splat_header *h = &c->hdr;
+    rs_result r = rs_rsf_check_for_save(c, name, err);
+    if (r != RS_OK) return r;
     size_t notes_len = strlen(h->notes), header_size = header_size_for(notes_len);
     size_t total = header_size + (size_t)h->count * RSF_RECORD_SIZE + RSF_CRC_SIZE;
     uint8_t *b = calloc(1, total);
     if (!b) return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory for %zu bytes", name, total);
-    write_header(b, h, notes_len, header_size);
+    rs_rsf_write_fixed_header(b, h, RSF_VERSION_1, notes_len, header_size);
     uint8_t *p = b + header_size;
     for (size_t i = 0; i < h->count; i++, p += RSF_RECORD_SIZE)
         for (size_t k = 0; k < 4; k++) wr_u32(p + 4 * k, c->packed[i].w[k]);
@@ -342,20 +348,47 @@ static rs_result encode_file(const rs_splat_cloud *c, const char *name, void **o
     return RS_OK;
 }
 
-rs_result rs_splat_save_memory(const rs_splat_cloud *c, void **out_data, size_t *out_len, rs_error *err)
+static rs_result encode_file(const rs_splat_cloud *c, const rs_splat_save_desc *desc, const char *name,
+                             void **out_data, size_t *out_len, rs_error *err)
 {
-    assert(c && out_data && out_len);
-    return encode_file(c, "(memory)", out_data, out_len, err);
+    static const rs_splat_save_desc defaults;
+    if (!desc) desc = &defaults;
+    switch (desc->version) {
+    case 0:
+    case RSF_VERSION_2: return rs_rsf2_encode(c, desc, name, out_data, out_len, err);
+    case RSF_VERSION_1: return encode_v1(c, name, out_data, out_len, err);
+    default:
+        return rs_fail(err, RS_ERR_ARG, "%s: cannot write .rsf version %u (versions 1 and 2 exist)", name,
+                       desc->version);
+    }
 }
 
-rs_result rs_splat_save(const rs_splat_cloud *c, const char *path, rs_error *err)
+rs_result rs_splat_save_memory_with(const rs_splat_cloud *c, const rs_splat_save_desc *desc, void **out_data,
+                                    size_t *out_len, rs_error *err)
+{
+    assert(c && out_data && out_len);
+    return encode_file(c, desc, "(memory)", out_data, out_len, err);
+}
+
+rs_result rs_splat_save_memory(const rs_splat_cloud *c, void **out_data, size_t *out_len, rs_error *err)
+{
+    return rs_splat_save_memory_with(c, NULL, out_data, out_len, err);
+}
+
+rs_result rs_splat_save_with(const rs_splat_cloud *c, const char *path, const rs_splat_save_desc *desc,
+                             rs_error *err)
 {
     assert(c && path);
     void *data;
     size_t len;
-    rs_result r = encode_file(c, path, &data, &len, err);
+    rs_result r = encode_file(c, desc, path, &data, &len, err);
     if (r != RS_OK) return r;
     r = rs_file_write_atomic(path, data, len, err);
     free(data);
     return r;
+}
+
+rs_result rs_splat_save(const rs_splat_cloud *c, const char *path, rs_error *err)
+{
+    return rs_splat_save_with(c, path, NULL, err);
 }

@@ -80,11 +80,71 @@ uint32_t rs_splat_encode_normal(const float n[3])
     return best;
 }
 
+// The same search on the lattice of codes that are multiples of `step` (a power of two), within
+// +-(32767 rounded down to it): every candidate is a code a 16-bit reader decodes as is.
+static uint32_t encode_normal_lattice(const float n[3], int step)
+{
+    float d[3];
+    rs_splat_decode_normal(rs_splat_encode_normal(n), d);
+    double x = d[0], y = d[1], z = d[2];
+    double l1 = fabs(x) + fabs(y) + fabs(z);
+    double u = x / l1, v = y / l1;
+    if (z < 0.0) {
+        double fu = (1.0 - fabs(v)) * sign_not_zero(u);
+        double fv = (1.0 - fabs(u)) * sign_not_zero(v);
+        u = fu;
+        v = fv;
+    }
+    int lim = 32767 / step * step;
+    int u0 = (int)floor(u * 32767.0 / step) * step, v0 = (int)floor(v * 32767.0 / step) * step;
+    uint32_t best = 0;
+    double best_dot = -2.0;
+    for (int k = 0; k < 4; k++) {
+        int cu = RS_CLAMP(u0 + (k & 1) * step, -lim, lim);
+        int cv = RS_CLAMP(v0 + (k >> 1) * step, -lim, lim);
+        uint32_t code = pack_snorm16x2(cu, cv);
+        float e[3];
+        rs_splat_decode_normal(code, e);
+        double el = sqrt((double)e[0] * e[0] + (double)e[1] * e[1] + (double)e[2] * e[2]);
+        double dot = (x * e[0] + y * e[1] + z * e[2]) / el;
+        if (dot > best_dot) {
+            best_dot = dot;
+            best = code;
+        }
+    }
+    return best;
+}
+
+void rs_splat_quantize_normals(rs_splat_cloud *c, int bits)
+{
+    assert(c && bits >= 8 && bits <= 16);
+    if (bits == 16) return;
+    int step = 1 << (16 - bits);
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        c->packed[i].w[2] = encode_normal_lattice(c->normal[i], step);
+        rs_splat_decode_normal(c->packed[i].w[2], c->normal[i]);
+    }
+}
+
 // r = radius_min * (radius_max / radius_min)^(q / 255)
 static float decode_radius(const rs_splat_header *h, uint32_t q)
 {
     double rmin = h->radius_min, rmax = h->radius_max;
     return (float)(rmin * pow(rmax / rmin, (double)q / 255.0));
+}
+
+void rs_splat_quantize_radii(rs_splat_cloud *c, int bits)
+{
+    assert(c && bits >= 4 && bits <= 8);
+    if (bits == 8) return;
+    uint32_t step = 1u << (8 - bits), top = 255u / step * step;
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        uint32_t w = c->packed[i].w[1], q = (w >> 16) & 0xffu;
+        // Nearest multiple of step, in the log domain where the codes are even.
+        q = RS_MIN((q + step / 2) / step * step, top);
+        c->packed[i].w[1] = (w & 0xff00ffffu) | q << 16;
+        c->radius[i] = decode_radius(&c->hdr, q);
+    }
 }
 
 // Rounding in the log domain minimises the relative error: at most half a log step.
@@ -355,44 +415,59 @@ void rs_splat_destroy(rs_splat_cloud *c)
     free(c);
 }
 
-rs_result rs_splat_decode_all(rs_splat_cloud *c, const char *name, bool in_file, size_t payload_off,
-                              rs_error *err)
+rs_result rs_splat_decode_range(rs_splat_cloud *c, uint32_t first, uint32_t n, rs_splat_decode_state *st,
+                                const rs_splat_where *where, rs_error *err)
 {
     const rs_splat_header *h = &c->hdr;
-    check_ctx x = {name, in_file, err};
-    // decode_unorm16 with the step hoisted out of the loop (same float operations, same result).
-    float lo[3], step[3], radius_of[256];
-    for (int a = 0; a < 3; a++) {
-        lo[a] = h->bbox_min[a];
-        step[a] = (h->bbox_max[a] - h->bbox_min[a]) / 65535.0f;
+    check_ctx x = {where->name, where->in_file, err};
+    char chunk[32] = "";
+    if (where->chunk >= 0) snprintf(chunk, sizeof chunk, "chunk %lld: ", (long long)where->chunk);
+    if (!st->ready) {
+        // decode_unorm16 with the step hoisted out of the loop (same float operations, same result).
+        for (int a = 0; a < 3; a++) {
+            st->lo[a] = h->bbox_min[a];
+            st->step[a] = (h->bbox_max[a] - h->bbox_min[a]) / 65535.0f;
+        }
+        // 256 radii per file: a table keeps pow() out of the per-splat loop.
+        for (uint32_t q = 0; q < 256; q++) st->radius_of[q] = decode_radius(h, q);
+        st->ready = true;
     }
-    // 256 radii per file: a table keeps pow() out of the per-splat loop.
-    for (uint32_t q = 0; q < 256; q++) radius_of[q] = decode_radius(h, q);
-    uint32_t counts[RS_SPLAT_MAX_REGIONS] = {0};
-    double area = 0, extent = bbox_extent(h);
-    for (uint32_t i = 0; i < h->count; i++) {
+    const float *lo = st->lo, *step = st->step, *radius_of = st->radius_of;
+    double area = 0;
+    for (uint32_t i = first; i < first + n; i++) {
         const uint32_t *w = c->packed[i].w;
         uint32_t region = w[1] >> 24, flags = w[3] >> 24;
-        size_t off = payload_off + (size_t)i * RSF_RECORD_SIZE;
+        size_t off = where->off + (size_t)(i - first) * where->stride;
         if (region >= h->region_count)
-            return bad(&x, off + 7, "splat %u: region %u is not in the region table (%u regions)", i, region,
-                       h->region_count);
+            return bad(&x, off + (where->stride ? 7 : 0), "%ssplat %u: region %u is not in the region table (%u regions)",
+                       chunk, i, region, h->region_count);
         if (flags != 0 && !(h->flags & RS_SPLAT_FLAG_AO))
-            return bad(&x, off + 15, "splat %u: byte 15 is 0x%02x but the header has no ambient occlusion", i, flags);
+            return bad(&x, off + (where->stride ? 15 : 0), "%ssplat %u: byte 15 is 0x%02x but the header has no ambient "
+                       "occlusion", chunk, i, flags);
         c->pos[i][0] = lo[0] + (float)(w[0] & 0xffffu) * step[0];
         c->pos[i][1] = lo[1] + (float)(w[0] >> 16) * step[1];
         c->pos[i][2] = lo[2] + (float)(w[1] & 0xffffu) * step[2];
         rs_splat_decode_normal(w[2], c->normal[i]);
         c->radius[i] = radius_of[(w[1] >> 16) & 0xffu];
         area += (double)c->radius[i] * c->radius[i];
-        counts[region]++;
+        st->region_counts[region]++;
     }
-    area *= 3.14159265358979;
-    if (area > RS_SPLAT_AREA_MAX * extent * extent)
-        return bad(&x, payload_off, "radii: the splats cover %.3g times the bounding box's largest face (at most %g): "
-                   "not a surface scan, and too costly to draw", area / (extent * extent), RS_SPLAT_AREA_MAX);
-    memcpy(c->region_counts, counts, sizeof counts);
+    st->area += area;
+    double extent = bbox_extent(h), total = st->area * 3.14159265358979;
+    if (total > RS_SPLAT_AREA_MAX * extent * extent)
+        return bad(&x, where->off, "%sradii: the splats cover %.3g times the bounding box's largest face (at most %g): "
+                   "not a surface scan, and too costly to draw", chunk, total / (extent * extent), RS_SPLAT_AREA_MAX);
     return RS_OK;
+}
+
+rs_result rs_splat_decode_all(rs_splat_cloud *c, const char *name, bool in_file, size_t payload_off,
+                              rs_error *err)
+{
+    rs_splat_decode_state st = {0};
+    rs_splat_where where = {name, in_file, payload_off, RSF_RECORD_SIZE, -1};
+    rs_result r = rs_splat_decode_range(c, 0, c->hdr.count, &st, &where, err);
+    if (r == RS_OK) memcpy(c->region_counts, st.region_counts, sizeof st.region_counts);
+    return r;
 }
 
 // Weyrich et al. 2006, Table 1 (METHOD.md): the midpoint of each measured range; "other" skin is the

@@ -1,9 +1,10 @@
 // splat.h — the splat cloud in memory and the compact .rsf file format (docs/rsf.md).
 //
 // Does: hold a face as splats (packed 16-byte records, GPU-ready, plus decoded float copies for the CPU);
-// encode float splats into records; load/validate and save .rsf files (atomic write); LOD prefixes;
-// region table with the specular parameters; the face frame (centre, forward, up) used by the camera
-// and by mirror painting.
+// encode float splats into records; load/validate and save .rsf files (atomic write; version 2, chunked
+// and entropy-coded, by default; version 1 still loads and can be written); load progressively, the
+// coarse LOD levels first, from bytes as they arrive (rs_splat_loader); LOD prefixes; region table with
+// the specular parameters; the face frame (centre, forward, up) used by the camera and by mirror painting.
 // Does not: touch GL (the renderer uploads `packed` as is), read PLY (tools/pack/ply.c), or paint.
 //
 //   rs_error err = {0};
@@ -99,9 +100,63 @@ void rs_splat_destroy(rs_splat_cloud *c);
 // tables, field ranges). Errors name the field and byte offset.
 rs_result rs_splat_load(const char *path, rs_splat_cloud **out, rs_error *err);
 rs_result rs_splat_load_memory(const void *data, size_t len, rs_splat_cloud **out, rs_error *err);
-// Serialises to .rsf (atomic: temp file + rename).
+// Serialises to .rsf version 2 (atomic: temp file + rename).
 rs_result rs_splat_save(const rs_splat_cloud *c, const char *path, rs_error *err);
 rs_result rs_splat_save_memory(const rs_splat_cloud *c, void **out_data, size_t *out_len, rs_error *err);
+
+// How to write a file; the zero value is the default (rs_splat_save's).
+typedef struct rs_splat_save_desc {
+    uint32_t version;       // 0: the newest (2); 1: version 1 (16 B a splat, for old readers and tests)
+    uint32_t chunk_splats;  // v2: at most this many splats per chunk (0: 65536); chunks never straddle a
+                            // LOD level, so a reader can draw each level as soon as its chunks arrive
+    int level;              // v2: zstd level 1..22 (0: 17; the size barely changes above 15, the time does)
+} rs_splat_save_desc;
+rs_result rs_splat_save_with(const rs_splat_cloud *c, const char *path, const rs_splat_save_desc *desc,
+                             rs_error *err);
+rs_result rs_splat_save_memory_with(const rs_splat_cloud *c, const rs_splat_save_desc *desc, void **out_data,
+                                    size_t *out_len, rs_error *err);
+
+// ---- progressive loading ----
+//
+// Feed a file's bytes as they arrive (from a slow disk, a pipe, the network), in pieces of any size; the
+// loader checks the header, then decodes and checks each chunk as soon as it is complete. A v2 file
+// stores the coarsest LOD level first, so the face can be drawn from the first few percent of the file
+// and refined as the rest arrives. A version-1 file is decoded when it is complete.
+//
+//   rs_splat_loader *l;
+//   rs_splat_loader_create(&(rs_splat_loader_desc){.name = path}, &l, &err);
+//   while ((n = read(fd, buf, sizeof buf)) > 0 && rs_splat_loader_feed(l, buf, n, &err) == RS_OK)
+//       if (rs_splat_loader_ready(l) > shown) { rs_splat_loader_preview(l, rs_splat_loader_ready(l), &p, &err); ... }
+//   rs_splat_loader_finish(l, &cloud, &err);  rs_splat_loader_destroy(l);
+typedef struct rs_splat_loader rs_splat_loader;
+
+typedef struct rs_splat_loader_desc {
+    const char *name;       // for messages (NULL: "(stream)"); copied
+    uint64_t total_bytes;   // the file's size when known (a regular file): checked against the header
+                            // before anything is allocated. 0: unknown (a stream); then memory grows
+                            // only with the chunks that have arrived, whatever the header claims
+} rs_splat_loader_desc;
+
+rs_result rs_splat_loader_create(const rs_splat_loader_desc *desc, rs_splat_loader **out, rs_error *err);
+void rs_splat_loader_destroy(rs_splat_loader *l);
+// Takes the next `len` bytes of the file. Errors (malformed bytes, bytes past the end) are sticky: the
+// loader refuses everything after its first error and repeats it.
+rs_result rs_splat_loader_feed(rs_splat_loader *l, const void *data, size_t len, rs_error *err);
+// The checked header once it has arrived, else NULL.
+const rs_splat_header *rs_splat_loader_header(const rs_splat_loader *l);
+// Splats decoded and checked so far, a prefix of the LOD order (a v1 file: 0 until rs_splat_loader_finish).
+uint32_t rs_splat_loader_decoded(const rs_splat_loader *l);
+// The largest LOD prefix (a value of the LOD table) decoded so far, 0 while there is none.
+uint32_t rs_splat_loader_ready(const rs_splat_loader *l);
+// True once every byte the header announces has arrived (then rs_splat_loader_finish succeeds).
+bool rs_splat_loader_complete(const rs_splat_loader *l);
+// A cloud of its own holding the first n splats (n: a LOD prefix <= rs_splat_loader_ready), for drawing
+// while the rest loads: its header is the file's with count n, the LOD levels up to n, and the radius
+// range scaled by sqrt(count / n) so the smaller set still closes the surface (rs_splat_lod_radius_scale).
+rs_result rs_splat_loader_preview(const rs_splat_loader *l, uint32_t n, rs_splat_cloud **out, rs_error *err);
+// After the last byte: checks that the file was complete and hands over the whole cloud (the loader
+// keeps nothing of it). *out is untouched on failure.
+rs_result rs_splat_loader_finish(rs_splat_loader *l, rs_splat_cloud **out, rs_error *err);
 
 // Decodes record i (as the GPU sees it).
 void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out);
@@ -113,6 +168,19 @@ float rs_splat_ao(const rs_splat_cloud *c, uint32_t i);
 uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count);
 // Radius multiplier for drawing only the first n splats: sqrt(count / n).
 float rs_splat_lod_radius_scale(const rs_splat_cloud *c, uint32_t n);
+
+// Re-encodes every normal on a coarser octahedral lattice: codes that are multiples of 2^(16 - bits),
+// bits 8..16 (the records stay 16-bit; a reader sees no difference). A scan's normals carry far less
+// precision than 16 bits give (0.0025 degrees); each bit dropped saves about 2 bits a splat in a v2
+// file. 12 bits: at most 0.05 degrees of error (docs/rsf.md). pos/normal arrays follow the records.
+void rs_splat_quantize_normals(rs_splat_cloud *c, int bits);
+
+// Rounds every radius code to a multiple of 2^(8 - bits), bits 4..8 (codes stay 8-bit): a scan's
+// radius (its local spacing) is far noisier than the 8-bit log code's steps (0.33 % for the bundled
+// head). 6 bits: relative error at most 2 codes' worth, 2 x ln(radius_max / radius_min) / 255 (0.67 %
+// for the bundled head), 3 at the top of the range (253..255 go to 252); 2 bits a splat less in a v2
+// file. The radius array follows the records.
+void rs_splat_quantize_radii(rs_splat_cloud *c, int bits);
 
 // Octahedral normal coding, exposed for tests and shaders' CPU mirror.
 uint32_t rs_splat_encode_normal(const float n[3]);

@@ -437,6 +437,8 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     make_notes(hdr->notes, in->comments, d->notes);
     r = rs_splat_create(splats, n, hdr, out, err);
     if (r != RS_OK) goto out;
+    rs_splat_quantize_normals(*out, RS_PACK_NORMAL_BITS);
+    rs_splat_quantize_radii(*out, RS_PACK_RADIUS_BITS);
     step_end(&c);
     if (!d->no_ao) {
         step_begin(&c, RS_PACK_STEP_AO);
