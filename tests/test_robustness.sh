@@ -345,6 +345,14 @@ for f in "$bad"/fuzz/envmap/*; do
     if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_envmap_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_envmap_$b"; fi
     rm -f "$tmp/o.rse"
 done
+for f in "$bad"/fuzz/image/*; do
+    [ -f "$f" ] || continue
+    b=$(basename "$f")
+    "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture "$f" -o "$tmp/o.rsf" >/dev/null 2>&1
+    rc=$?
+    if [ "$rc" -ge 128 ] || [ -e "$tmp/o.rsf" ]; then echo "FAIL - robust_fuzz_image_$b: exit $rc"; else echo "ok - robust_fuzz_image_$b"; fi
+    rm -f "$tmp/o.rsf"
+done
 for kind in strokes look; do
     for f in "$bad/fuzz/$kind"/*; do
         [ -f "$f" ] || continue

@@ -11,17 +11,20 @@
 #   tools/fuzz/fuzz_convert.c PLY -> convert -> preview -> save/load  tests/fixtures/ply + bad/ply_*
 #   tools/fuzz/fuzz_env.c    rs_env_load_memory (src/formats/env.c)  tests/fixtures/env
 #   tools/fuzz/fuzz_envmap.c rouge-env's .hdr/.exr readers (tools/env/env_read.c, exr_read.cpp) tests/fixtures/env
+#   tools/fuzz/fuzz_import.c assimp import -> pages -> convert (tools/pack/import_assimp.c) tests/fixtures/import
+#   tools/fuzz/fuzz_image.c  PNG / JPEG texture decode (tools/pack/image_load.c)  tests/fixtures/image, import
 # plus, for each, the inputs kept from earlier crashes: tests/fixtures/bad/fuzz/<name>/ (run first, as
 # regression tests; the ordinary test suite also feeds them to the real programs, tests/test_robustness.sh).
 #
-# Environment: FUZZ_SECONDS (default 60 per harness), FUZZ_TARGETS (default "ply rsf strokes look convert env envmap"),
+# Environment: FUZZ_SECONDS (default 60 per harness), FUZZ_TARGETS (default "ply rsf strokes look convert env envmap
+# import image"),
 # FUZZ_DIR (default build/fuzz), FUZZ_JOBS (parallel harness runs, default 1: the machine may be shared).
 # Exit status: 0 no crash, 1 a crash/leak/timeout (the reproducer's path is printed), 2 cannot build.
 # Needs clang with libFuzzer and the sanitizer runtimes (Debian: clang, libclang-rt-14-dev).
 set -u
 cd "$(dirname "$0")/.." || exit 2
 seconds=${FUZZ_SECONDS:-60}
-targets=${FUZZ_TARGETS:-ply rsf strokes look convert env envmap}
+targets=${FUZZ_TARGETS:-ply rsf strokes look convert env envmap import image}
 dir=${FUZZ_DIR:-build/fuzz}
 jobs=${FUZZ_JOBS:-1}
 cc=${FUZZ_CC:-clang}
@@ -48,10 +51,10 @@ make --no-print-directory -s BUILD="$dir/lib" CC="$cc" OPT=-O1 \
     EXTRA_CFLAGS="-Wno-unknown-warning-option -fsanitize=fuzzer-no-link $san" \
     "$dir/lib/librouge.a" "$dir/lib/libpack.a" >"$dir/build.log" 2>&1 ||
     { tail -n 20 "$dir/build.log" >&2; die "library build failed (log: $dir/build.log)"; }
-pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm libzstd 2>/dev/null)
+pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm libzstd assimp 2>/dev/null)
 for t in $targets; do
     src="tools/fuzz/fuzz_$t.c"
-    [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert env envmap)"
+    [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert env envmap import image)"
     extra_c="" extra_obj="" link="$cc"
     if [ "$t" = envmap ]; then
         # rouge-env's readers: C parts compiled in, the OpenEXR C++ reader with clang++, linked as C++.
@@ -79,6 +82,8 @@ seeds_of() {
         look) echo tests/fixtures/looks ;;
         convert) echo tests/fixtures/ply ;;
         env | envmap) echo tests/fixtures/env ;;
+        import) echo tests/fixtures/import ;;
+        image) echo tests/fixtures/image ;;
     esac
 }
 
@@ -99,6 +104,8 @@ run_one() {
     # Seeds are copied (never fuzzed in place: libFuzzer writes new inputs into its corpus directory).
     extra=""
     [ "$t" = convert ] && extra="tests/fixtures/bad/ply_*"
+    [ "$t" = import ] && extra="tests/fixtures/import/head/head.mtl"
+    [ "$t" = image ] && extra="tests/fixtures/import/*.jpg tests/fixtures/import/*.png tests/fixtures/bad/png_*"
     # shellcheck disable=SC2086
     for f in "$(seeds_of "$t")"/* tests/fixtures/bad/fuzz/"$t"/* $extra; do
         [ -f "$f" ] && cp "$f" "$corpus/"

@@ -33,8 +33,50 @@
 // claiming more is a decompression bomb, refused before stb allocates the image.
 #define JPEG_MIN_BITS_PER_BLOCK 1u
 
+// Walks the JPEG's marker segments (and over the entropy-coded data after each scan header, where
+// progressive files put further tables) and checks every Huffman table before stb sees it: stb 2.27
+// (Debian's) writes past its 257-entry size list when a table's 16 counts add up to more than 256,
+// which the JPEG standard forbids (found by tools/fuzz/fuzz_image.c). Returns NULL or what is wrong.
+static const char *jpeg_tables_bad(const uint8_t *d, size_t len)
+{
+    size_t i = 2;  // after SOI
+    while (i + 4 <= len) {
+        if (d[i] != 0xff) return "bytes between marker segments";  // stb would resynchronise past them
+        uint8_t m = d[i + 1];
+        if (m == 0xff) {  // fill byte
+            i++;
+            continue;
+        }
+        if (m == 0xd9) return NULL;  // EOI
+        if (m == 0x01 || (m >= 0xd0 && m <= 0xd7)) {  // TEM, RSTn: no length
+            i += 2;
+            continue;
+        }
+        size_t seg = (size_t)d[i + 2] << 8 | d[i + 3];
+        if (seg < 2 || i + 2 + seg > len) return "a marker segment runs past the end of the file";
+        if (m == 0xc4) {  // DHT: tables of 1 + 16 + sum(counts) bytes
+            size_t p = i + 4, end = i + 2 + seg;
+            while (p < end) {
+                if (p + 17 > end) return "a Huffman table is cut short";
+                unsigned sum = 0;
+                for (int k = 1; k <= 16; k++) sum += d[p + k];
+                if (sum > 256) return "a Huffman table has more than 256 codes";
+                p += 17 + sum;
+                if (p > end) return "a Huffman table's symbols run past its segment";
+            }
+        }
+        i += 2 + seg;
+        if (m == 0xda) {  // SOS: skip the entropy-coded data to the next real marker
+            while (i + 1 < len && !(d[i] == 0xff && d[i + 1] != 0x00 && !(d[i + 1] >= 0xd0 && d[i + 1] <= 0xd7))) i++;
+        }
+    }
+    return NULL;
+}
+
 static rs_result decode_jpeg(const uint8_t *data, size_t len, const char *name, rs_image *out, rs_error *err)
 {
+    const char *bad = jpeg_tables_bad(data, len);
+    if (bad) return rs_fail(err, RS_ERR_FORMAT, "%s: bad JPEG data (%s)", name, bad);
     if (len > (size_t)INT32_MAX) return rs_fail(err, RS_ERR_LIMIT, "%s: JPEG of %zu bytes is too large", name, len);
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(data, (int)len, &w, &h, &comp))
