@@ -345,6 +345,14 @@ for f in "$bad"/fuzz/envmap/*; do
     if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_envmap_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_envmap_$b"; fi
     rm -f "$tmp/o.rse"
 done
+for f in "$bad"/fuzz/import/*; do
+    [ -f "$f" ] || continue
+    b=$(basename "$f")
+    "$pack" "$f" --points 500 -o "$tmp/o.rsf" >/dev/null 2>&1
+    rc=$?
+    if [ "$rc" -ge 128 ]; then echo "FAIL - robust_fuzz_import_$b: signal $((rc - 128))"; else echo "ok - robust_fuzz_import_$b"; fi
+    rm -f "$tmp/o.rsf"
+done
 for f in "$bad"/fuzz/image/*; do
     [ -f "$f" ] || continue
     b=$(basename "$f")
