@@ -1,14 +1,16 @@
 // shadow_lookup.glsl — stage 1's consumer side: visibility of the key light at a view-space point from the
 // splat shadow map (orthographic, fitted to the cloud's bounding sphere), with a receiver-plane depth bias
-// against acne and a 4x4 grid of the hardware's bilinear 2x2 PCF, 1.5 texels apart: a penumbra about
-// 8 texels (~2 mm on the bundled head) wide, as from a small studio light rather than a point. A sharper
-// edge would leave a band of pure red at every shadow boundary (the skin profile's red reaches millimetres
-// past an edge that green and blue barely cross), which reads as a painted outline.
+// against acne and a 4x4 grid of the hardware's bilinear 2x2 PCF, 1.5 texels of a 2048^2 map apart
+// whatever the map's own size: a penumbra about 2 mm wide on the bundled head, as from a small studio
+// light rather than a point. A sharper edge would leave a band of pure red at every shadow boundary (the
+// skin profile's red reaches millimetres past an edge that green and blue barely cross), which reads as a
+// painted outline.
 uniform highp sampler2DShadow u_shadow_map;
 uniform mat4 u_shadow_matrix;   // view space -> light clip space
 uniform mat3 u_shadow_normals;  // view-space normals -> light clip space (inverse transpose)
 uniform float u_shadow_on;      // 0: no shadows (everything lit)
-uniform float u_shadow_texel;   // 1 / shadow map size (the PCF grid's)
+uniform float u_shadow_texel;   // the PCF grid's texel, uv (1 / 2048)
+uniform float u_shadow_map_texel;  // the map's own texel, uv (1 / its size)
 uniform float u_shadow_bias;    // window-depth units
 uniform vec3 u_shadow_dir;      // towards the light, view space
 
@@ -34,12 +36,16 @@ float rs_shadow(vec3 p, vec3 n)
     vec2 grad = -nc.xy / (abs(nc.z) > 1e-4 ? nc.z : 1e-4);
     float glen = length(grad);
     if (glen > 4.0) grad *= 4.0 / glen;
-    // Each tap's bilinear footprint spans a texel: half of it in slope, plus the constant.
-    float bias = u_shadow_bias * (1.0 + slope) + 1.5 * u_shadow_texel * min(glen, 4.0);
+    // Each tap compares the 2x2 texels around it, up to a texel of the map away along the receiver's
+    // plane: that much slope, plus the constant.
+    float bias = u_shadow_bias * (1.0 + slope) + u_shadow_map_texel * min(glen, 4.0);
     float sum = 0.0;
     for (int y = 0; y < 4; y++)
         for (int x = 0; x < 4; x++) {
-            vec2 o = (vec2(x, y) - 1.5) * 1.5 * u_shadow_texel;
+            // The grid turned by atan(1/4): its 16 taps fall at 16 distinct distances from an edge
+            // along either axis, so taps several texels apart still ramp smoothly.
+            vec2 g = vec2(x, y) - 1.5;
+            vec2 o = vec2(0.9701 * g.x - 0.2425 * g.y, 0.2425 * g.x + 0.9701 * g.y) * 1.5 * u_shadow_texel;
             sum += textureLod(u_shadow_map, vec3(s.xy + o, s.z + dot(grad, o) - bias), 0.0);
         }
     return sum / 16.0 * attached;

@@ -102,8 +102,11 @@ typedef struct rs_diffusion_level {
 // reference's rule) blurs the decimated image and grows its silhouette: 34.7 instead of 41.8 dB
 // against the reference at 512x512 with the 145k prefix.
 #define RS_MOBILE_COVER 0.55f
-#define RS_SHADOW_SIZE_REFERENCE 2048
-#define RS_SHADOW_SIZE_MOBILE 1024
+#define RS_SHADOW_SIZE_REFERENCE 4096
+#define RS_SHADOW_SIZE_MOBILE 2048
+// The PCF filter's grid step is 1.5 texels of a map this size whatever the map's own size, so that
+// every pipeline casts the same penumbra (render_shadow.c).
+#define RS_SHADOW_SIZE_PCF 2048
 
 // A shadow map and what it was drawn for (cached while the light, LOD and radius stay the same); one per
 // pipeline so that switching pipelines (the bench's interleaved frames, the viewer's toggle) redraws none.

@@ -1,16 +1,19 @@
 // render_shadow.c — stage 1, the shadow map (paper Fig. 2): the splats' depth seen from the key light,
 // an orthographic frustum fitted to the cloud's bounding sphere, drawn with the visibility pass's ray-disk
-// shader (no push). Lookups (shaders_es/shadow_lookup.glsl) use a normal offset and a depth bias of about
-// one splat radius (acne comes from neighbouring disks disagreeing by up to that much) and a 3x3 grid of
-// hardware 2x2 PCF. The map only depends on the light and the LOD, so it is cached across camera moves,
-// one per pipeline (the mobile one at half the resolution, from the mobile LOD prefix).
+// shader (no push). Lookups (shaders_es/shadow_lookup.glsl) compare each PCF tap against the receiver's
+// own plane (receiver-plane depth bias, no normal offset) on a turned 4x4 grid of hardware 2x2 PCF. The
+// map only depends on the light and the LOD, so it is cached across camera moves, one per pipeline (the
+// mobile one at a quarter of the resolution, from the mobile LOD prefix).
 #include "render/render_internal.h"
 
 #include <math.h>
 #include <string.h>
 
-// Reference: 2048^2 keeps a texel near 0.3 mm on the bundled bust (bounding sphere ~6 units, 47 mm/unit).
-// Mobile: 1024^2 (RS_SHADOW_SIZE_MOBILE), texels of ~0.6 mm, still below the PCF penumbra (~8 texels).
+// Reference: 4096^2, texels of 0.14 mm on the bundled bust (bounding sphere 6.2 units, 47 mm/unit). An
+// occluder's edge in the map is quantised to texels, which moves its shadow's edge by up to half a texel
+// / cos(theta) on the receiver: 0.29 mm at 60 degrees with 2048^2 (over the 0.3 mm the edge may be off),
+// 0.14 mm with 4096^2 (tests/test_shadow.c). Mobile: 1024^2 (RS_SHADOW_SIZE_MOBILE), texels of 0.57 mm,
+// still below the PCF penumbra (~2 mm); its edges are within 0.6 mm.
 
 void rs_render_shadow_release(rs_renderer *r)
 {
@@ -113,16 +116,18 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
     }
     // Lookups come from view space: view -> model -> light clip.
     glm_mat4_mul(m->vp, f->cam.inv_view, f->shadow_matrix);
-    // The filter is sized in the reference map's texels whatever this map's size, so that the mobile
-    // pipeline's half-resolution map gives the same penumbra (its PCF taps are then 0.75 texels apart,
-    // still bilinear-smooth); only the quantisation term of the bias follows the map's own texels.
+    // The filter is sized in texels of a 2048^2 map whatever this map's size, so that every pipeline
+    // gives the same penumbra (the taps are 3 texels apart in the reference's map, 0.75 in the mobile's;
+    // the turned grid keeps the former smooth); the bias's texel terms follow the map's own texels.
     float texel = 2.0f * R / (float)m->size;
-    float texel_pcf = 2.0f * R / (float)RS_MIN(RS_SHADOW_SIZE_REFERENCE, r->caps.max_texture_size);
+    float texel_pcf = 2.0f * R / (float)RS_SHADOW_SIZE_PCF;
     f->shadow_texel = texel_pcf / (2.0f * R);
     // A disk departs from the surface it samples by ~r^2 / 2R at its rim (curvature radius R ~ 0.3 of
     // the face height on cheeks and nose) plus r sin(3 deg) from normal noise: ~0.15 r on the bundled
-    // head; a texel of quantisation on top. Depth bias in window units (the ortho range is 2.02 R). The
-    // slope is the receiver plane's, per PCF tap (shadow_lookup.glsl): no normal offset.
+    // head (no acne at 0.15 r on the test sphere or the cheek under grazing light); 0.5 r keeps a margin
+    // for the normal map's tilts, and moves only contact shadows, by bias x tan(theta). A texel of
+    // quantisation on top. Depth bias in window units (the ortho range is 2.02 R). The slope is the
+    // receiver plane's, per PCF tap (shadow_lookup.glsl): no normal offset.
     f->shadow_bias = (0.5f * m->radius + texel) / (2.02f * R);
     // Normals into light clip space: the inverse transpose of the view -> light clip map's linear part.
     mat3 a, inv;
@@ -139,6 +144,7 @@ void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint p
     glUniform1f(rs_uloc(prog, "u_shadow_on"), f->shadows && tex ? 1.0f : 0.0f);
     glUniformMatrix4fv(rs_uloc(prog, "u_shadow_matrix"), 1, GL_FALSE, (const float *)f->shadow_matrix);
     glUniform1f(rs_uloc(prog, "u_shadow_texel"), f->shadow_texel);
+    glUniform1f(rs_uloc(prog, "u_shadow_map_texel"), 1.0f / (float)RS_MAX(r->shadow[f->shadow_slot].size, 1));
     glUniform1f(rs_uloc(prog, "u_shadow_bias"), f->shadow_bias);
     glUniformMatrix3fv(rs_uloc(prog, "u_shadow_normals"), 1, GL_FALSE, (const float *)f->shadow_normals);
     glUniform3fv(rs_uloc(prog, "u_shadow_dir"), 1, f->key_dir);
