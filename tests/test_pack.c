@@ -199,42 +199,180 @@ static void test_normals_on_demosthenes_agree_with_given(void)
 
 // Ambient occlusion (pack_ao.c) against analytic answers: a flat floor sees the whole upper hemisphere
 // (1); the bottom of a hemispherical bowl sees the sky through its rim at 45 degrees from the axis, a
-// cosine-weighted fraction of sin^2(45) = 0.5; a splat under a lid sees nothing above (0 within the
-// sampling's reach).
+// cosine-weighted fraction of sin^2(45) = 0.5; a floor point at distance d from the foot of a long wall
+// of height h misses the wall's form factor, AO = 1/2 + d / (2 sqrt(d^2 + h^2)); a splat under a lid
+// sees nothing above it but what slips in under the lid's edge.
 static void test_ambient_occlusion_matches_analytic_cases(void)
 {
-    enum { K = 60, BOWL = 4000 };
-    rs_splat *s = calloc(K * K + BOWL + 1, sizeof *s);
-    uint8_t *ao = malloc(K * K + BOWL + 1);
+    enum { K = 60, BOWL = 4000, WALL_X = 200, WALL_Z = 50, LID = 40 };
+    size_t cap = K * K + BOWL + WALL_X * (WALL_Z + 3) + LID * LID + 1, n = 0;
+    rs_splat *s = calloc(cap, sizeof *s);
+    uint8_t *ao = malloc(cap);
     RS_REQUIRE(s && ao, "out of memory");
-    // A floor (z = 0, normal +z), 2 x 2 units, well away from the bowl.
+    // A floor (z = 0, normal +z), 2 x 2 units, well away from the rest.
     for (int y = 0; y < K; y++)
         for (int x = 0; x < K; x++) {
-            rs_splat *p = &s[y * K + x];
+            rs_splat *p = &s[n++];
             p->pos[0] = -6.0f + 2.0f * x / (K - 1), p->pos[1] = 2.0f * y / (K - 1), p->normal[2] = 1.0f;
             p->radius = 2.0f / K;
         }
+    uint32_t floor_end = (uint32_t)n;
     // A bowl of radius 1 centred at (3, 0, 1): the lower hemisphere, normals pointing inwards (to the centre).
-    uint32_t bottom = K * K;
+    uint32_t bottom = (uint32_t)n;
     for (int i = 0; i < BOWL; i++) {
         float z = -1.0f + (float)i / BOWL, r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), phi = 2.39996323f * (float)i;
-        rs_splat *p = &s[K * K + i];
+        rs_splat *p = &s[n++];
         float d[3] = {r * cosf(phi), r * sinf(phi), z};
         for (int a = 0; a < 3; a++) p->pos[a] = d[a] + (a == 0 ? 3.0f : a == 2 ? 1.0f : 0.0f), p->normal[a] = -d[a];
         p->radius = 0.04f;
-        if (i == 0) bottom = K * K + i;
     }
+    // A wall 8 units long, 1 high (x = 0, y in [-4, 4] shifted to y = -12, normal +x), and three floor
+    // splats in front of its middle at d = 0.25, 0.5, 1.
+    for (int i = 0; i < WALL_X; i++)
+        for (int k = 0; k <= WALL_Z; k++) {
+            rs_splat *p = &s[n++];
+            p->pos[1] = -16.0f + 8.0f * i / (WALL_X - 1), p->pos[2] = (float)k / WALL_Z, p->normal[0] = 1.0f;
+            p->radius = 0.04f;
+        }
+    const float wall_d[3] = {0.25f, 0.5f, 1.0f};
+    uint32_t wall_probe = (uint32_t)n;
+    for (int i = 0; i < 3; i++) {
+        rs_splat *p = &s[n++];
+        p->pos[0] = wall_d[i], p->pos[1] = -12.0f, p->normal[2] = 1.0f, p->radius = 0.02f;
+    }
+    // A lid: a 2 x 2 square 0.2 above a splat (at (-3, -6, 0)); the sky shows only below its edges,
+    // atan(0.2 / 1) ~ 11 degrees above the horizon at most: AO <= cos^2(78.7 deg) = 0.04.
+    for (int y = 0; y < LID; y++)
+        for (int x = 0; x < LID; x++) {
+            rs_splat *p = &s[n++];
+            p->pos[0] = -4.0f + 2.0f * x / (LID - 1), p->pos[1] = -7.0f + 2.0f * y / (LID - 1), p->pos[2] = 0.2f;
+            p->normal[2] = 1.0f;
+            p->radius = 2.0f / LID;
+        }
+    uint32_t under = (uint32_t)n;
+    s[n].pos[0] = -3.0f, s[n].pos[1] = -6.0f, s[n].normal[2] = 1.0f, s[n].radius = 0.02f;
+    n++;
     rs_error err = {0};
-    RS_REQUIRE(rs_pack_ao(s, K * K + BOWL, ao, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_pack_ao(s, (uint32_t)n, ao, &err) == RS_OK, "%s", err.msg);
     double floor_mean = 0;
-    for (int i = 0; i < K * K; i++) floor_mean += ao[i] / 255.0;
-    floor_mean /= K * K;
-    float b = ao[bottom] / 255.0f;
-    printf("# ambient occlusion: floor %.3f (1), bowl bottom %.3f (0.5)\n", floor_mean, b);
-    RS_CHECK(floor_mean > 0.97, "open floor: AO %.3f, want ~1", floor_mean);
-    RS_CHECK(fabsf(b - 0.5f) < 0.1f, "bowl bottom: AO %.3f, want 0.5", b);
+    for (uint32_t i = 0; i < floor_end; i++) floor_mean += ao[i] / 255.0;
+    floor_mean /= floor_end;
+    float b = ao[bottom] / 255.0f, lid = ao[under] / 255.0f;
+    printf("# ambient occlusion: floor %.3f (1), bowl bottom %.3f (0.5), under a lid %.3f (~0)\n", floor_mean, b,
+           lid);
+    RS_CHECK(floor_mean > 0.99, "open floor: AO %.3f, want ~1", floor_mean);
+    RS_CHECK(fabsf(b - 0.5f) < 0.06f, "bowl bottom: AO %.3f, want 0.5", b);
+    RS_CHECK(lid < 0.06f, "under a lid: AO %.3f, want ~0", lid);
+    for (int i = 0; i < 3; i++) {
+        float d = wall_d[i], want = 0.5f + d / (2.0f * sqrtf(d * d + 1.0f)), got = ao[wall_probe + i] / 255.0f;
+        printf("# %.2f from the foot of a wall as high: AO %.3f (%.3f)\n", d, got, want);
+        RS_CHECK(fabsf(got - want) < 0.05f, "%.2f from a wall: AO %.3f, want %.3f", d, got, want);
+    }
     free(s);
     free(ao);
+}
+
+// The bundled face's occlusion where an artist expects it, as regional means over splats picked in the
+// face frame (nose tip = the most forward splat, H = face height): eye sockets, the underside of the
+// nose, under the chin and the ear's concha clearly darker than the cheek and forehead, which see
+// nearly the whole sky. Leaves a front and a side view of the occlusion in the test output to look at.
+enum { AO_CHEEK, AO_FOREHEAD, AO_EYE, AO_NOSTRIL, AO_CHIN, AO_EAR, AO_REGIONS };
+
+static int ao_region(const rs_splat_cloud *c, uint32_t i, const float tip[3], int cheek, int forehead)
+{
+    const float *p = c->pos[i], *n = c->normal[i];
+    float H = c->hdr.face_height, x = fabsf(p[0] - tip[0]) / H, y = (p[1] - tip[1]) / H, z = (p[2] - tip[2]) / H;
+    // The bundled face's frame is +y up, +z forward (checked by the caller).
+    if (x > 0.05f && x < 0.25f && y > 0.05f && y < 0.18f && z > -0.32f && n[2] > 0.0f) return AO_EYE;
+    if (x < 0.1f && y > -0.1f && y < -0.01f && z > -0.19f && n[1] < -0.3f) return AO_NOSTRIL;
+    if (x < 0.19f && y > -0.54f && y < -0.34f && z > -0.42f && n[1] < -0.5f) return AO_CHIN;
+    float ex = x - 0.31f, ey = y - 0.017f, ez = z + 0.49f;
+    if (x > 0.28f && ex > -0.06f && ex * ex + ey * ey + ez * ez < 0.06f * 0.06f) return AO_EAR;
+    int region = (int)(c->packed[i].w[1] >> 24);
+    return region == cheek ? AO_CHEEK : region == forehead ? AO_FOREHEAD : -1;
+}
+
+// Orthographic CPU views of the occlusion (grey) beside the colour, front and side, nearest splat wins.
+static void save_ao_views(const rs_splat_cloud *c)
+{
+    enum { W = 400 };
+    rs_image img = {0};
+    float *zb = malloc(sizeof(float) * 2 * W * W);
+    if (!zb || rs_image_create(2 * W, 2 * W, 3, &img, NULL) != RS_OK) {
+        free(zb);
+        return;
+    }
+    for (int i = 0; i < 2 * W * W; i++) zb[i] = -INFINITY;
+    const float *m = c->hdr.centre;
+    float s = W / (1.3f * c->hdr.face_height);
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        const float *p = c->pos[i];
+        rs_splat sp;
+        rs_splat_get(c, i, &sp);
+        uint8_t a = (uint8_t)lrintf(rs_splat_ao(c, i) * 255.0f);
+        for (int view = 0; view < 2; view++) {
+            float u = view ? m[2] - p[2] : p[0] - m[0], v = p[1] - m[1], d = view ? p[0] : p[2];
+            int x = (int)(W / 2 + u * s), y = (int)(W / 2 - v * s), rr = (int)ceilf(c->radius[i] * s);
+            for (int yy = y - rr; yy <= y + rr; yy++)
+                for (int xx = x - rr; xx <= x + rr; xx++) {
+                    if (xx < 0 || yy < 0 || xx >= W || yy >= W) continue;
+                    float *z = &zb[view * W * W + yy * W + xx];
+                    if (d <= *z) continue;
+                    *z = d;
+                    uint8_t *q = img.pixels + ((size_t)(yy + view * W) * 2 * W + xx) * 3;
+                    q[0] = q[1] = q[2] = a;
+                    memcpy(q + 3 * W, sp.rgb, 3);
+                }
+        }
+    }
+    rs_test_save("face_ambient_occlusion", &img);
+    rs_image_free(&img);
+    free(zb);
+}
+
+static void test_bundled_face_occlusion_darkens_eyes_nostrils_chin_and_ears(void)
+{
+    rs_splat_cloud *c = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_splat_load("assets/face.rsf", &c, &err) == RS_OK, "%s", err.msg);
+    const rs_splat_header *h = &c->hdr;
+    if (!RS_CHECK(h->flags & RS_SPLAT_FLAG_AO, "assets/face.rsf has no ambient occlusion") ||
+        !RS_CHECK(h->up[1] > 0.99f && h->forward[2] > 0.99f, "the bundled face's frame is not +y up, +z forward")) {
+        rs_splat_destroy(c);
+        return;
+    }
+    int cheek = -1, forehead = -1;
+    for (uint32_t r = 0; r < h->region_count; r++) {
+        if (!strcmp(h->regions[r].name, "cheek")) cheek = (int)r;
+        if (!strcmp(h->regions[r].name, "forehead")) forehead = (int)r;
+    }
+    uint32_t tip = 0;
+    for (uint32_t i = 1; i < h->count; i++)
+        if (c->pos[i][2] > c->pos[tip][2]) tip = i;
+    double sum[AO_REGIONS] = {0};
+    int count[AO_REGIONS] = {0};
+    for (uint32_t i = 0; i < h->count; i++) {
+        int r = ao_region(c, i, c->pos[tip], cheek, forehead);
+        if (r < 0) continue;
+        sum[r] += rs_splat_ao(c, i);
+        count[r]++;
+    }
+    static const char *names[AO_REGIONS] = {"cheek", "forehead", "eye sockets", "under the nose", "under the chin",
+                                            "ear concha"};
+    double mean[AO_REGIONS];
+    for (int r = 0; r < AO_REGIONS; r++) {
+        mean[r] = count[r] ? sum[r] / count[r] : NAN;
+        printf("# ambient occlusion, %-14s %6d splats, mean %.3f\n", names[r], count[r], mean[r]);
+        RS_CHECK(count[r] > 500, "%s: only %d splats picked", names[r], count[r]);
+    }
+    double open = fmin(mean[AO_CHEEK], mean[AO_FOREHEAD]);
+    RS_CHECK(open > 0.93, "cheek %.3f / forehead %.3f: open skin should see nearly all the sky", mean[AO_CHEEK],
+             mean[AO_FOREHEAD]);
+    for (int r = AO_EYE; r < AO_REGIONS; r++)
+        RS_CHECK(mean[r] < open - 0.12, "%s: AO %.3f, not clearly darker than the cheek and forehead (%.3f)",
+                 names[r], mean[r], open);
+    save_ao_views(c);
+    rs_splat_destroy(c);
 }
 
 static void test_radius_matches_grid_spacing(void)
@@ -860,6 +998,7 @@ int main(int argc, char **argv)
     RS_RUN(test_normals_on_demosthenes_agree_with_given);
     RS_RUN(test_radius_matches_grid_spacing);
     RS_RUN(test_ambient_occlusion_matches_analytic_cases);
+    RS_RUN(test_bundled_face_occlusion_darkens_eyes_nostrils_chin_and_ears);
     RS_RUN(test_lod_prefix_is_spatially_uniform);
     RS_RUN(test_lod_prefix_covers_surface);
     RS_RUN(test_morton_order_keeps_levels_compact);

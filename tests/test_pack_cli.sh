@@ -83,6 +83,7 @@ has pack_info_lists_lods "$tmp/out" "LOD prefixes"
 has pack_info_lists_regions "$tmp/out" "rho_s"
 has pack_info_lists_notes "$tmp/out" "converted by rouge-pack"
 has pack_writes_version_2 "$tmp/out" ".rsf version 2"
+has pack_info_reports_occlusion "$tmp/out" "ambient occlusion per splat: mean"
 head -c 300 "$tmp/g.rsf" >"$tmp/trunc.rsf"
 expect pack_info_truncated 1 "trunc.rsf" "$pack" --info "$tmp/trunc.rsf"
 expect pack_info_missing 1 "cannot open" "$pack" --info "$tmp/none.rsf"
@@ -100,6 +101,25 @@ expect pack_rewrite_refuses_conversion_options 2 "conversion options do not appl
 no_file pack_rewrite_refusal_leaves_no_output "$tmp/up2.rsf"
 expect pack_rewrite_of_a_damaged_rsf 1 "crc: stored" "$pack" tests/fixtures/rsf/bad_crc.rsf -o "$tmp/up3.rsf"
 no_file pack_rewrite_failure_leaves_no_output "$tmp/up3.rsf"
+
+# Ambient occlusion: --no-ao leaves none (and --info says so); --ao adds it to such a file, and gives the
+# same bytes as the conversion computed (both from the splats as the file stores them); bad uses refused.
+expect pack_converts_with_ao 0 "" "$pack" "$fx/mesh_st.ply" -o "$tmp/y.rsf" --points 2000 -q --texture tests/fixtures/image/a_8x8.png
+expect pack_no_ao_flag 0 "" "$pack" "$fx/mesh_st.ply" -o "$tmp/n.rsf" --points 2000 -q --no-ao --texture tests/fixtures/image/a_8x8.png
+"$pack" --info "$tmp/n.rsf" >"$tmp/n.info" 2>&1
+has pack_info_says_no_occlusion "$tmp/n.info" "occlusion     none"
+expect pack_ao_adds_occlusion 0 "" "$pack" --ao "$tmp/n.rsf" -o "$tmp/a2.rsf"
+if cmp -s "$tmp/a2.rsf" "$tmp/y.rsf"; then echo "ok - pack_ao_equals_conversion"; else echo "FAIL - pack_ao_equals_conversion: --ao on a --no-ao file differs from converting with occlusion"; fi
+expect pack_ao_in_place 0 "" "$pack" --ao "$tmp/n.rsf" -o "$tmp/n.rsf" -q
+if cmp -s "$tmp/n.rsf" "$tmp/y.rsf"; then echo "ok - pack_ao_in_place_rewrites_file"; else echo "FAIL - pack_ao_in_place_rewrites_file: differs"; fi
+expect pack_ao_keeps_version_1 0 "" "$pack" --ao tests/fixtures/rsf/tiny_v1.rsf -o "$tmp/v1ao.rsf" -q
+"$pack" --info "$tmp/v1ao.rsf" >"$tmp/v1ao.info" 2>&1
+has pack_ao_kept_version_1 "$tmp/v1ao.info" ".rsf version 1"
+has pack_ao_added_to_version_1 "$tmp/v1ao.info" "ambient occlusion per splat"
+expect pack_ao_needs_output 2 "no output" "$pack" --ao "$tmp/y.rsf"
+expect pack_ao_with_input 2 "--ao takes only" "$pack" --ao "$tmp/y.rsf" "$fx/points_le.ply" -o "$tmp/z.rsf"
+expect pack_ao_truncated 1 "trunc.rsf" "$pack" --ao "$tmp/trunc.rsf" -o "$tmp/z.rsf"
+no_file pack_ao_failure_leaves_no_output "$tmp/z.rsf"
 
 # A PLY whose comment is Latin-1 and carries a bidi override converts (the note is made valid, terminal-safe
 # UTF-8), and --info prints it escaped: no raw override reaches the terminal.

@@ -133,6 +133,8 @@ bad_input rsf_ply_given_as_face "a PLY given as the face" 1 "magic:" "$tmp/o.png
     "$rouge" render tests/fixtures/ply/points_le.ply -o "$tmp/o.png"
 bad_input rsf_info_truncated "rouge-pack --info on a truncated .rsf" 1 "cut_payload.rsf:" - \
     "$pack" --info "$tmp/cut_payload.rsf"
+bad_input rsf_ao_truncated "rouge-pack --ao on a truncated .rsf" 1 "cut_payload.rsf:" "$tmp/o.rsf" \
+    "$pack" --ao "$tmp/cut_payload.rsf" -o "$tmp/o.rsf"
 
 # ---- PLY (rouge-pack) ----
 while IFS='|' read -r file pat what; do

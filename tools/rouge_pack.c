@@ -21,6 +21,7 @@ static const char usage[] =
     "usage: rouge-pack INPUT -o OUT.rsf [options]\n"
     "       rouge-pack --info FILE.rsf [--preview PNG]\n"
     "       rouge-pack OLD.rsf -o NEW.rsf    (rewrites an .rsf as version 2, records and notes as they are)\n"
+    "       rouge-pack --ao FILE.rsf -o OUT.rsf\n"
     "\n"
     "Converts a scan into rouge's compact splat file (.rsf version 2: about 8 bytes per splat, entropy-\n"
     "coded, the coarsest LOD level first so viewers can show it while the rest loads): normals (estimated\n"
@@ -68,6 +69,9 @@ static const char usage[] =
     "  --preview PNG       also write a CPU preview: front colour, front regions, side regions\n"
     "  -q, --quiet         no progress bar, no summary\n"
     "  --info FILE.rsf     print counts, bytes per splat, LOD and region tables, frame and notes\n"
+    "  --ao FILE.rsf       (re)compute an .rsf's ambient occlusion, all else kept (its version too);\n"
+    "                      files from before rouge-pack computed it have none, and the environment\n"
+    "                      then lights every splat as if open to the sky. OUT may be FILE\n"
     "  -h, --help          this text\n"
     "\n"
     "Exit status: 0 done, 1 conversion or file error, 2 usage.\n";
@@ -200,6 +204,19 @@ static int info(const char *path, const char *preview)
     for (uint32_t i = 0; i < h->lod_count; i++)
         printf("    %2u  %9u splats  %6.2f%%  radius x %.3f\n", i, h->lods[i], 100.0 * h->lods[i] / h->count,
                rs_splat_lod_radius_scale(c, h->lods[i]));
+    if (h->flags & RS_SPLAT_FLAG_AO) {
+        double sum = 0;
+        uint32_t low = 0;
+        for (uint32_t i = 0; i < h->count; i++) {
+            float a = rs_splat_ao(c, i);
+            sum += a;
+            low += a < 0.5f;
+        }
+        printf("  occlusion     ambient occlusion per splat: mean %.3f, %.1f%% below 0.5\n", sum / h->count,
+               100.0 * low / h->count);
+    } else {
+        printf("  occlusion     none (every splat open to the sky; rouge-pack --ao adds it)\n");
+    }
     printf("  regions       %u\n", h->region_count);
     for (uint32_t i = 0; i < h->region_count; i++)
         printf("    %2u  %-10s m %.4f  rho_s %.4f  %9u splats (%5.2f%%)\n", i, h->regions[i].name, h->regions[i].m,
@@ -257,6 +274,31 @@ static int rewrite(const char *in, const char *out, bool quiet)
         printf("rouge-pack: %s -> %s: %u splats rewritten as .rsf version 2, %.2f bytes/splat (was %.2f)\n", in, out, n,
                (double)file_size(out) / n, (double)file_size(in) / n);
     return 0;
+}
+
+// --ao: the occlusion of an existing file recomputed, the rest of it kept, its version too (rewriting
+// it as the newest version is the plain `rouge-pack OLD.rsf -o NEW.rsf`).
+static int recompute_ao(const char *path, const char *output, bool quiet)
+{
+    rs_error err = {0};
+    rs_splat_cloud *c = NULL;
+    if (rs_splat_load(path, &c, &err) != RS_OK) return fail(1, "%s", err.msg);
+    // The version field (bytes 4..7, little-endian) of a file that just loaded.
+    unsigned char b[8] = {0};
+    FILE *f = fopen(path, "rb");
+    size_t got = f ? fread(b, 1, sizeof b, f) : 0;
+    if (f) fclose(f);
+    uint32_t version = got == sizeof b ? (uint32_t)b[4] | (uint32_t)b[5] << 8 | (uint32_t)b[6] << 16 | (uint32_t)b[7] << 24 : 0;
+    double t0 = rs_time_now();
+    int rc = 0;
+    if (rs_pack_ao_cloud(c, &err) != RS_OK ||
+        rs_splat_save_with(c, output, &(rs_splat_save_desc){.version = version == 1 ? 1 : 0}, &err) != RS_OK)
+        rc = fail(1, "%s", err.msg);
+    else if (!quiet)
+        printf("rouge-pack: %s -> %s: ambient occlusion of %u splats (%.2f s)\n", path, output, c->hdr.count,
+               rs_time_now() - t0);
+    rs_splat_destroy(c);
+    return rc;
 }
 
 // ---- conversion ----
@@ -457,7 +499,7 @@ static int convert(options *o)
 int main(int argc, char **argv)
 {
     options o = {0};
-    const char *info_path = NULL;
+    const char *info_path = NULL, *ao_path = NULL;
     bool mm_given = false;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -479,7 +521,7 @@ int main(int argc, char **argv)
         } else if (a[0] == '-' && a[1] != 0) {
             static const char *const known[] = {"-o", "--output", "--points", "--texture", "--normal-map",
                                                 "--specular-map", "--region-map", "--mm-per-unit", "--units", "--min-lod",
-                                                "--seed", "--up", "--forward", "--preview", "--info"};
+                                                "--seed", "--up", "--forward", "--preview", "--info", "--ao"};
             bool ok = false;
             for (size_t k = 0; k < RS_COUNT_OF(known); k++) ok |= !strcmp(a, known[k]);
             if (!ok) return fail(2, "unknown option '%s' (see --help)", a);
@@ -495,6 +537,7 @@ int main(int argc, char **argv)
         if (!strcmp(a, "-o") || !strcmp(a, "--output")) o.output = v;
         else if (!strcmp(a, "--preview")) o.preview = v;
         else if (!strcmp(a, "--info")) info_path = v;
+        else if (!strcmp(a, "--ao")) ao_path = v;
         else if (!strcmp(a, "--points")) {
             if (!parse_u64(v, 1, RS_SPLAT_MAX_COUNT, &n)) return fail(2, "--points: expected a count 1..%u, got '%s'", RS_SPLAT_MAX_COUNT, v);
             o.desc.points = (uint32_t)n;
@@ -522,6 +565,11 @@ int main(int argc, char **argv)
     if (info_path) {
         if (o.input || o.output) return fail(2, "--info takes only an .rsf file (and --preview)");
         return info(info_path, o.preview);
+    }
+    if (ao_path) {
+        if (o.input || info_path || o.preview) return fail(2, "--ao takes only an .rsf file and -o OUT.rsf");
+        if (!o.output) return fail(2, "no output: give -o OUT.rsf");
+        return recompute_ao(ao_path, o.output, o.quiet);
     }
     if (!o.input) return fail(2, "no input scan (see --help)");
     if (o.units && mm_given) return fail(2, "--units and --mm-per-unit both give the scale: use one");

@@ -283,6 +283,9 @@ typedef struct rs_pack_report {
 // the sphere from which nothing of the cloud hides the splat, q/255. A few seconds for 600k splats.
 #define RS_PACK_AO_DIRS 96
 rs_result rs_pack_ao(const rs_splat *splats, uint32_t n, uint8_t *ao, rs_error *err);
+// The same for a cloud's splats as the file stores them (quantised), set into it (RS_SPLAT_FLAG_AO):
+// converting and `rouge-pack --ao` on the result give the same bytes.
+rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err);
 
 // Converts a loaded PLY into a cloud ready for rs_splat_save. `report` may be NULL.
 rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_splat_cloud **out,

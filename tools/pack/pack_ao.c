@@ -11,12 +11,61 @@
 #include <string.h>
 
 #define AO_MAP 512      // depth map side, texels, over the cloud's bounding sphere
-#define PI_F 3.14159265358979f
 
-// Splats are drawn into the depth maps as discs of their radius (at least one texel), keeping the depth
-// nearest to the sky. A splat is open towards d when its own depth is within `bias` of the map's: two
-// radii (neighbouring discs on a curved surface stand a little proud of each other) plus a texel scaled
-// by the slope towards d.
+// One direction's orthonormal frame: d towards the sky, (u, v) across it.
+typedef struct ao_dir {
+    float d[3], u[3], v[3];
+} ao_dir;
+
+static ao_dir fibonacci_dir(int k)
+{
+    // Fibonacci sphere: evenly spread directions.
+    ao_dir o;
+    float z = 1.0f - (2.0f * (float)k + 1.0f) / RS_PACK_AO_DIRS, r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+    float phi = 2.39996323f * (float)k;
+    float *d = o.d, *u = o.u, *v = o.v;
+    d[0] = r * cosf(phi), d[1] = r * sinf(phi), d[2] = z;
+    float t[3] = {fabsf(d[0]) < 0.9f ? 1.0f : 0.0f, fabsf(d[0]) < 0.9f ? 0.0f : 1.0f, 0.0f};
+    u[0] = d[1] * t[2] - d[2] * t[1], u[1] = d[2] * t[0] - d[0] * t[2], u[2] = d[0] * t[1] - d[1] * t[0];
+    float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    for (int a = 0; a < 3; a++) u[a] /= ul;
+    v[0] = d[1] * u[2] - d[2] * u[1], v[1] = d[2] * u[0] - d[0] * u[2], v[2] = d[0] * u[1] - d[1] * u[0];
+    return o;
+}
+
+static float dot3(const float a[3], const float b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+// Draws splat s (centre p relative to the cloud's centre) into the depth map seen from o.d, keeping the
+// depth nearest to the sky: the disk as what it is from there, an ellipse (semi-axes r across its tilt,
+// r |n.d| along it, at least ~a texel) at its plane's depth. A circle of radius r at the centre's depth
+// would stand up to r tan(angle) above a tilted neighbour's centre and hide it from the sky: every open
+// surface came out ~0.07 too dark, grainy with the normal map's tilts.
+static void draw_disk(float *depth, const ao_dir *o, const float p[3], const rs_splat *s, float R, float texel)
+{
+    float x = (dot3(p, o->u) + R) / texel, y = (dot3(p, o->v) + R) / texel, h = dot3(p, o->d);
+    float nu = dot3(s->normal, o->u), nv = dot3(s->normal, o->v), nd = dot3(s->normal, o->d);
+    float r = s->radius / texel, tilt = sqrtf(nu * nu + nv * nv);
+    // e: the tilt's direction in the map (the ellipse's minor axis); edge-on disks get a texel of width.
+    float ex = tilt > 1e-6f ? nu / tilt : 1.0f, ey = tilt > 1e-6f ? nv / tilt : 0.0f;
+    float rr = fmaxf(r, 0.71f), minor = fmaxf(r * fabsf(nd), 0.71f);
+    // Depth along d per texel of map offset, on the disk's plane (bounded: the disk spans +-r in depth).
+    float gx = fabsf(nd) > 1e-3f ? -nu / nd * texel : 0.0f, gy = fabsf(nd) > 1e-3f ? -nv / nd * texel : 0.0f;
+    float reach = s->radius;
+    int x0 = (int)floorf(x - rr), x1 = (int)floorf(x + rr), y0 = (int)floorf(y - rr), y1 = (int)floorf(y + rr);
+    for (int yy = RS_MAX(y0, 0); yy <= RS_MIN(y1, AO_MAP - 1); yy++)
+        for (int xx = RS_MAX(x0, 0); xx <= RS_MIN(x1, AO_MAP - 1); xx++) {
+            float dx = (float)xx + 0.5f - x, dy = (float)yy + 0.5f - y;
+            float along = dx * ex + dy * ey, across = dy * ex - dx * ey;
+            if (across * across / (rr * rr) + along * along / (minor * minor) > 1.0f) continue;
+            float hh = h + RS_CLAMP(dx * gx + dy * gy, -reach, reach);
+            float *z = &depth[yy * AO_MAP + xx];
+            if (hh > *z) *z = hh;
+        }
+}
+
+// A splat is open towards d when its own depth is within `bias` of the map's at its centre: a radius
+// (neighbouring disks on a curved surface, or tilted by the normal map, stand a little proud of each
+// other) plus a texel scaled by the slope towards d (the texel's centre is up to a texel from the splat's).
 rs_result rs_pack_ao(const rs_splat *s, uint32_t n, uint8_t *ao, rs_error *err)
 {
     if (n == 0) return RS_OK;
@@ -39,45 +88,22 @@ rs_result rs_pack_ao(const rs_splat *s, uint32_t n, uint8_t *ao, rs_error *err)
     }
     float texel = 2.0f * R / AO_MAP;
     for (int k = 0; k < RS_PACK_AO_DIRS; k++) {
-        // Fibonacci sphere: evenly spread directions.
-        float z = 1.0f - (2.0f * (float)k + 1.0f) / RS_PACK_AO_DIRS, r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        float phi = 2.39996323f * (float)k;
-        float d[3] = {r * cosf(phi), r * sinf(phi), z};
-        // An orthonormal basis (u, v) across d.
-        float t[3] = {fabsf(d[0]) < 0.9f ? 1.0f : 0.0f, fabsf(d[0]) < 0.9f ? 0.0f : 1.0f, 0.0f};
-        float u[3] = {d[1] * t[2] - d[2] * t[1], d[2] * t[0] - d[0] * t[2], d[0] * t[1] - d[1] * t[0]};
-        float ul = sqrtf(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-        for (int a = 0; a < 3; a++) u[a] /= ul;
-        float v[3] = {d[1] * u[2] - d[2] * u[1], d[2] * u[0] - d[0] * u[2], d[0] * u[1] - d[1] * u[0]};
+        ao_dir o = fibonacci_dir(k);
         for (int i = 0; i < AO_MAP * AO_MAP; i++) depth[i] = -INFINITY;
         for (uint32_t i = 0; i < n; i++) {
             float p[3] = {(float)(s[i].pos[0] - c[0]), (float)(s[i].pos[1] - c[1]), (float)(s[i].pos[2] - c[2])};
-            float x = (p[0] * u[0] + p[1] * u[1] + p[2] * u[2] + R) / texel;
-            float y = (p[0] * v[0] + p[1] * v[1] + p[2] * v[2] + R) / texel;
-            float h = p[0] * d[0] + p[1] * d[1] + p[2] * d[2];
-            float rr = fmaxf(s[i].radius / texel, 0.71f);
-            int x0 = (int)floorf(x - rr), x1 = (int)floorf(x + rr), y0 = (int)floorf(y - rr), y1 = (int)floorf(y + rr);
-            for (int yy = RS_MAX(y0, 0); yy <= RS_MIN(y1, AO_MAP - 1); yy++)
-                for (int xx = RS_MAX(x0, 0); xx <= RS_MIN(x1, AO_MAP - 1); xx++) {
-                    float dx = (float)xx + 0.5f - x, dy = (float)yy + 0.5f - y;
-                    if (dx * dx + dy * dy > rr * rr) continue;
-                    float *o = &depth[yy * AO_MAP + xx];
-                    if (h > *o) *o = h;
-                }
+            draw_disk(depth, &o, p, &s[i], R, texel);
         }
         for (uint32_t i = 0; i < n; i++) {
-            float nd = s[i].normal[0] * d[0] + s[i].normal[1] * d[1] + s[i].normal[2] * d[2];
+            float nd = dot3(s[i].normal, o.d);
             if (nd <= 0.0f) continue;
             float p[3] = {(float)(s[i].pos[0] - c[0]), (float)(s[i].pos[1] - c[1]), (float)(s[i].pos[2] - c[2])};
-            int x = (int)floorf((p[0] * u[0] + p[1] * u[1] + p[2] * u[2] + R) / texel);
-            int y = (int)floorf((p[0] * v[0] + p[1] * v[1] + p[2] * v[2] + R) / texel);
-            float h = p[0] * d[0] + p[1] * d[1] + p[2] * d[2];
+            int x = (int)floorf((dot3(p, o.u) + R) / texel), y = (int)floorf((dot3(p, o.v) + R) / texel);
             x = RS_CLAMP(x, 0, AO_MAP - 1), y = RS_CLAMP(y, 0, AO_MAP - 1);
-            // Slope-scaled, as for any depth map: seen at a grazing angle a texel spans depth.
             float slope = fminf(sqrtf(fmaxf(1.0f - nd * nd, 0.0f)) / nd, 10.0f);
-            float bias = 2.0f * s[i].radius + texel * (1.0f + slope);
+            float bias = s[i].radius + texel * (1.0f + slope);
             total[i] += nd;
-            if (h >= depth[y * AO_MAP + x] - bias) open[i] += nd;
+            if (dot3(p, o.d) >= depth[y * AO_MAP + x] - bias) open[i] += nd;
         }
     }
     for (uint32_t i = 0; i < n; i++) {
@@ -88,4 +114,18 @@ rs_result rs_pack_ao(const rs_splat *s, uint32_t n, uint8_t *ao, rs_error *err)
     free(open);
     free(total);
     return RS_OK;
+}
+
+rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err)
+{
+    uint32_t n = c->hdr.count;
+    rs_splat *s = malloc(sizeof *s * (size_t)RS_MAX(n, 1u));
+    uint8_t *ao = malloc(RS_MAX(n, 1u));
+    rs_result r = s && ao ? RS_OK : rs_fail(err, RS_ERR_NOMEM, "ambient occlusion: out of memory");
+    for (uint32_t i = 0; r == RS_OK && i < n; i++) rs_splat_get(c, i, &s[i]);
+    if (r == RS_OK) r = rs_pack_ao(s, n, ao, err);
+    if (r == RS_OK) rs_splat_set_ao(c, ao);
+    free(s);
+    free(ao);
+    return r;
 }

@@ -442,10 +442,7 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     step_end(&c);
     if (!d->no_ao) {
         step_begin(&c, RS_PACK_STEP_AO);
-        uint8_t *ao = malloc(n);
-        r = ao ? rs_pack_ao(splats, n, ao, err) : rs_fail(err, RS_ERR_NOMEM, "out of memory");
-        if (r == RS_OK) rs_splat_set_ao(*out, ao);
-        free(ao);
+        r = rs_pack_ao_cloud(*out, err);
         if (r != RS_OK) {
             rs_splat_destroy(*out);
             *out = NULL;
