@@ -17,6 +17,11 @@
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <ctype.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <time.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdarg.h>
@@ -83,7 +88,7 @@ void rs_app_print_viewer_help(FILE *f)
             "  scroll DY | key NAME (p, [, ?, ctrl+z, shift+tab, f11, esc, ...) | touch ID down|move|up X Y\n"
             "  drop FILE | step S (script clock per pointer event, default 1/60 s) | frames N | wait S\n"
             "  idle (until full quality) | screenshot FILE [X Y W H] (PNG of the window or a region, after\n"
-            "  idle) | wait-for FILE (until FILE exists) | quit\n");
+            "  idle) | wait-for FILE (until FILE exists) | loaded (until the face file has loaded) | quit\n");
 }
 
 // The viewer's own options: --events, --bench-orbit, and whether --size / --pipeline were given.
@@ -151,7 +156,8 @@ static void apply_brush(vw_viewer *v)
                         .opacity = v->opacity, .pressure = RS_MAKEUP_PRESSURE_FLOOR, .eraser = v->eraser,
                         .mirror = v->mirror};
     rs_paint_set_brush(v->paint, &b);
-    rs_paint_set_mode(v->paint, v->paint_mode ? RS_INPUT_PAINT : RS_INPUT_VIEW);
+    // A preview's makeup would be lost when the whole face replaces it: painting waits for the rest.
+    rs_paint_set_mode(v->paint, v->paint_mode && !v->partial ? RS_INPUT_PAINT : RS_INPUT_VIEW);
 }
 
 static void select_cosmetic(vw_viewer *v, int i)
@@ -288,10 +294,61 @@ static void upload(vw_viewer *v, rs_makeup_range d)
 
 // --- the face: load (in a thread, with a loading screen), open, swap -------------------------------------
 
+#define VW_READ_BYTES (256u << 10)
+#define VW_PREVIEW_EVERY_S 0.5  // a slow stream refines at most this often (each face opened costs a renderer)
+#define VW_PREVIEW_AFTER_S 0.1  // a local 600k face loads in ~40 ms: no preview for it
+
+// Reads the file (or standard input for "-") into an rs_splat_loader, publishing previews as LOD levels
+// complete. Standard input is polled so that quitting cancels a stalled stream.
 static void *load_main(void *arg)
 {
     vw_loader *l = arg;
-    l->result = rs_splat_load(l->path, &l->cloud, &l->err);
+    bool in = !strcmp(l->path, "-");
+    int fd = in ? 0 : open(l->path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    rs_splat_loader *ld = NULL;
+    uint8_t *buf = NULL;
+    rs_result r = RS_OK;
+    struct stat st;
+    uint64_t size = 0;
+    if (fd < 0) r = rs_fail(&l->err, RS_ERR_IO, "%s: cannot open: %s", l->path, strerror(errno));
+    else if (!in && fstat(fd, &st) != 0) r = rs_fail(&l->err, RS_ERR_IO, "%s: cannot stat: %s", l->path, strerror(errno));
+    // Regular files only (or an explicit "-"): a directory, /dev/zero or a FIFO would hang or never end.
+    else if (!in && !S_ISREG(st.st_mode)) r = rs_fail(&l->err, RS_ERR_IO, "%s: not a regular file", l->path);
+    else size = in ? 0 : (uint64_t)st.st_size;
+    if (!r) r = rs_splat_loader_create(&(rs_splat_loader_desc){.name = in ? "(standard input)" : l->path,
+                                                               .total_bytes = size}, &ld, &l->err);
+    if (!r && !(buf = malloc(VW_READ_BYTES))) r = rs_fail(&l->err, RS_ERR_NOMEM, "%s: out of memory", l->path);
+    uint32_t shown = 0;
+    double last = 0;
+    while (!r && !atomic_load(&l->cancel) && !rs_splat_loader_complete(ld)) {
+        if (in) {
+            struct pollfd pfd = {.fd = fd, .events = POLLIN};
+            if (poll(&pfd, 1, 100) == 0) continue;
+        }
+        ssize_t n = read(fd, buf, VW_READ_BYTES);
+        if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
+        if (n < 0) r = rs_fail(&l->err, RS_ERR_IO, "%s: read failed: %s", l->path, strerror(errno));
+        if (n <= 0) break;
+        r = rs_splat_loader_feed(ld, buf, (size_t)n, &l->err);
+        const rs_splat_header *h = rs_splat_loader_header(ld);
+        uint32_t ready = rs_splat_loader_ready(ld);
+        rs_splat_cloud *p = NULL;
+        if (!r && h && ready > shown && ready < h->count && (!shown || rs_time_now() - last >= VW_PREVIEW_EVERY_S)) {
+            rs_error e = {0};
+            if (rs_splat_loader_preview(ld, ready, &p, &e) == RS_OK) shown = ready, last = rs_time_now();
+        }
+        pthread_mutex_lock(&l->mu);
+        l->decoded = rs_splat_loader_decoded(ld);
+        l->count = h ? h->count : 0;
+        if (p) rs_splat_destroy(l->preview), l->preview = p;
+        pthread_mutex_unlock(&l->mu);
+    }
+    if (!r && atomic_load(&l->cancel)) r = rs_fail(&l->err, RS_ERR_IO, "%s: loading cancelled", l->path);
+    if (!r) r = rs_splat_loader_finish(ld, &l->cloud, &l->err);
+    rs_splat_loader_destroy(ld);
+    free(buf);
+    if (fd > 0) close(fd);
+    l->result = r;
     atomic_store(&l->done, true);
     return NULL;
 }
@@ -304,7 +361,12 @@ static rs_result load_start(vw_viewer *v, const char *path, rs_error *err)
     snprintf(l->path, sizeof l->path, "%s", path);
     l->t0 = glfwGetTime();
     atomic_store(&l->done, false);
-    if (pthread_create(&l->thread, NULL, load_main, l) != 0) return rs_fail(err, RS_ERR_NOMEM, "cannot start a loader thread");
+    atomic_store(&l->cancel, false);
+    pthread_mutex_init(&l->mu, NULL);
+    if (pthread_create(&l->thread, NULL, load_main, l) != 0) {
+        pthread_mutex_destroy(&l->mu);
+        return rs_fail(err, RS_ERR_NOMEM, "cannot start a loader thread");
+    }
     l->running = true;
     return RS_OK;
 }
@@ -315,8 +377,22 @@ static bool load_finished(vw_viewer *v)
     vw_loader *l = &v->load;
     if (!l->running || !atomic_load(&l->done)) return false;
     pthread_join(l->thread, NULL);
+    pthread_mutex_destroy(&l->mu);
+    rs_splat_destroy(l->preview);
+    l->preview = NULL;
     l->running = false;
     return true;
+}
+
+// Stops a load that is still running (the window closes) and drops what it made.
+static void load_abort(vw_viewer *v)
+{
+    vw_loader *l = &v->load;
+    if (!l->running) return;
+    atomic_store(&l->cancel, true);
+    while (!load_finished(v)) nanosleep(&(struct timespec){0, 10 * 1000 * 1000}, NULL);
+    rs_splat_destroy(l->cloud);
+    l->cloud = NULL;
 }
 
 // The interactive quality ladder: coarser LOD prefixes first (while the face keeps a dense enough look),
@@ -832,28 +908,48 @@ static double frame(vw_viewer *v, const char *script_shot, const float *script_r
     return ms;
 }
 
-// Finishes a background load: the new face replaces the old one, or the old one stays with an error.
-static rs_result poll_loader(vw_viewer *v, bool first, rs_error *err)
+// Shows a background load's progress: a preview of the LOD levels that have arrived (when the load is
+// slow enough for one to help), then the whole face; or keeps what is shown and says why it failed.
+static rs_result poll_loader(vw_viewer *v, rs_error *err)
 {
-    if (!load_finished(v)) return RS_OK;
     vw_loader *l = &v->load;
+    if (!l->running) return RS_OK;
+    if (!atomic_load(&l->done) && glfwGetTime() - l->t0 >= VW_PREVIEW_AFTER_S) {
+        pthread_mutex_lock(&l->mu);
+        rs_splat_cloud *p = l->preview;
+        l->preview = NULL;
+        pthread_mutex_unlock(&l->mu);
+        rs_error e = {0};
+        if (p && face_open(v, p, l->path, &e) == RS_OK) {
+            if (!v->partial) reset_camera(v);
+            v->partial = true;
+            apply_brush(v);
+        }
+    }
+    if (!load_finished(v)) return RS_OK;
+    bool was_partial = v->partial;
     rs_result r = l->result;
     if (!r) r = face_open(v, l->cloud, l->path, &l->err);
+    l->cloud = NULL;
+    v->partial = false;  // on failure a preview stays: all there is of that file
+    if (v->paint) apply_brush(v);
     if (r) {
-        if (first) return rs_fail(err, r, "%s", l->err.msg);
+        if (l->initial) return rs_fail(err, r, "%s", l->err.msg);
         vw_toast(v, true, "%s", l->err.msg);
         return RS_OK;
     }
-    reset_camera(v);
-    if (!first) vw_toast(v, false, "Opened %s", l->path);
+    if (!was_partial) reset_camera(v);
+    if (l->initial && v->cli->look && (r = load_look(v, true, err))) return r;
+    if (!l->initial) vw_toast(v, false, "Opened %s", l->path);
     return RS_OK;
 }
 
 // The picture on screen is the full-quality one and nothing is about to change it.
 static bool at_full_quality(const vw_viewer *v)
 {
-    return v->ren && !v->load.running && !interacting(v) && v->rendered_full && !v->dirty_view && !v->dirty_makeup &&
-           v->queue.count == 0;
+    // A preview at full quality is all there is to show until more of the file arrives.
+    return v->ren && (!v->load.running || v->partial) && !interacting(v) && v->rendered_full && !v->dirty_view &&
+           !v->dirty_makeup && v->queue.count == 0;
 }
 
 // ... and no screenshot is waiting for it (scripts' `idle` and `quit` wait for S too).
@@ -904,26 +1000,24 @@ static rs_result run(vw_viewer *v, rs_error *err)
         return rs_fail(err, RS_ERR_ARG, "%s", v->toast);
     rs_result r = load_start(v, c->face ? c->face : rs_app_default_face(def, sizeof def), err);
     if (r) return r;
-    // Loading screen until the face is there.
-    while (!v->ren) {
+    v->load.initial = true;
+    vw_options o = viewer_options(c);
+    // Loading screen until the face (or a preview of it) is there; the bench waits for all of it.
+    while (!v->ren || (o.bench_orbit > 0 && v->load.running)) {
         if (glfwWindowShouldClose(v->win)) {
-            pthread_join(v->load.thread, NULL);
-            v->load.running = false;
-            rs_splat_destroy(v->load.cloud);
+            load_abort(v);
             return RS_OK;
         }
         glfwPollEvents();
         v->queue.count = 0;  // input during loading is dropped (nothing to act on)
-        if ((r = poll_loader(v, true, err))) return r;
-        if (!v->ren) {
+        if ((r = poll_loader(v, err))) return r;
+        if (!v->ren || v->load.running) {
             frame(v, NULL, NULL, err);
             glfwWaitEventsTimeout(0.03);
         }
     }
-    if (c->look && (r = load_look(v, true, err))) return r;
     // One frame with the toolbar before any input: presses are routed by what the last frame drew.
     frame(v, NULL, NULL, err);
-    vw_options o = viewer_options(c);
     if (o.bench_orbit > 0) return bench_orbit(v, o.bench_orbit, err);
 
     while (!v->quit && !glfwWindowShouldClose(v->win)) {
@@ -932,10 +1026,10 @@ static rs_result run(vw_viewer *v, rs_error *err)
                     (v->toast[0] && vw_now() < v->toast_until + 0.1);
         if (busy) glfwPollEvents();
         else glfwWaitEventsTimeout(v->have_script ? 0.01 : 0.5);
-        if ((r = poll_loader(v, false, err))) return r;
+        if ((r = poll_loader(v, err))) return r;
         vw_script_step step = {0};
         if (v->have_script) {
-            vw_script_run(&v->script, &v->queue, settled(v), vw_now(), &step);
+            vw_script_run(&v->script, &v->queue, settled(v), v->load.running, vw_now(), &step);
             if (step.quit) v->quit = true;
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
         }
@@ -1002,7 +1096,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         rs_result r2 = rs_strokes_save(v->rec, cli->record, &e2);
         if (!r && r2) r = r2, *err = e2;
     }
-    if (v->load.running) pthread_join(v->load.thread, NULL), rs_splat_destroy(v->load.cloud);
+    load_abort(v);
     face_close(v);
     rs_env_destroy(v->env_cpu);
     rs_ui_texture_free(&v->before);

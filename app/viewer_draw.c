@@ -182,7 +182,14 @@ static void draw_loading(vw_viewer *v)
     int ts = RS_MAX(1, (int)(s * 2 + 0.25f));
     char line[600];
     const char *base = strrchr(v->load.path, '/');
-    snprintf(line, sizeof line, "Loading %s  %.1f s", base ? base + 1 : v->load.path, t);
+    pthread_mutex_lock(&v->load.mu);
+    uint32_t decoded = v->load.decoded, count = v->load.count;
+    pthread_mutex_unlock(&v->load.mu);
+    if (count)
+        snprintf(line, sizeof line, "Loading %s  %.1f s  %u of %u splats", base ? base + 1 : v->load.path, t, decoded,
+                 count);
+    else
+        snprintf(line, sizeof line, "Loading %s  %.1f s", base ? base + 1 : v->load.path, t);
     float w = rs_ui_text_width(line, ts);
     rs_ui_text(v->ui, cx - w * 0.5f, cy + 22 * s, ts, RS_UI_WHITE, line);
 }

@@ -247,9 +247,9 @@ static rs_result parse_line(parser *p, char **tok, int n)
         if (n != 2 || !num(tok[1], 1, 1e6, &a[0]) || a[0] != floor(a[0])) return BAD("expected a count (1..1000000)");
         return add(p, &(vw_cmd){.type = VW_CMD_FRAMES, .value = a[0]});
     }
-    if (!strcmp(c, "idle") || !strcmp(c, "quit")) {
+    if (!strcmp(c, "idle") || !strcmp(c, "quit") || !strcmp(c, "loaded")) {
         if (n != 1) return BAD("takes no values");
-        return add(p, &(vw_cmd){.type = c[0] == 'i' ? VW_CMD_IDLE : VW_CMD_QUIT});
+        return add(p, &(vw_cmd){.type = c[0] == 'i' ? VW_CMD_IDLE : c[0] == 'q' ? VW_CMD_QUIT : VW_CMD_LOADED});
     }
 #undef BAD
     return rs_fail(err, RS_ERR_FORMAT, "%s:%d: unknown command '%s' (see rouge --help, 'event scripts')", p->file,
@@ -307,7 +307,7 @@ void vw_script_free(vw_script *s)
     s->count = s->next = 0;
 }
 
-void vw_script_run(vw_script *s, vw_queue *q, bool settled, double now_s, vw_script_step *out)
+void vw_script_run(vw_script *s, vw_queue *q, bool settled, bool loading, double now_s, vw_script_step *out)
 {
     *out = (vw_script_step){0};
     if (s->done) return;
@@ -365,6 +365,10 @@ void vw_script_run(vw_script *s, vw_queue *q, bool settled, double now_s, vw_scr
             return;
         case VW_CMD_WAIT_FOR:
             if (access(c->path, F_OK) != 0) return;
+            s->next++;
+            break;
+        case VW_CMD_LOADED:
+            if (loading) return;
             s->next++;
             break;
         case VW_CMD_QUIT:

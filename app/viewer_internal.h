@@ -81,6 +81,8 @@ bool vw_queue_peek(const vw_queue *q, vw_event *ev);
 //                               of it, as a PNG
 //   wait-for FILE               keep running until FILE exists (sync with a test driving the window
 //                               from outside, e.g. xdotool)
+//   loaded                      keep running until the face file has loaded completely (a preview of
+//                               its first LOD levels may be on screen before)
 //   quit                        close the viewer (exit status 0)
 
 typedef enum vw_cmd_type {
@@ -91,6 +93,7 @@ typedef enum vw_cmd_type {
     VW_CMD_IDLE,
     VW_CMD_SCREENSHOT,
     VW_CMD_WAIT_FOR,
+    VW_CMD_LOADED,
     VW_CMD_QUIT,
 } vw_cmd_type;
 
@@ -132,23 +135,31 @@ typedef struct vw_script_step {
 } vw_script_step;
 
 // Runs commands until one blocks: pushes events into q. `settled` says the picture is at full quality
-// with nothing pending; now_s is the wall clock.
-void vw_script_run(vw_script *s, vw_queue *q, bool settled, double now_s, vw_script_step *out);
+// with nothing pending, `loading` that a face file is still loading; now_s is the wall clock.
+void vw_script_run(vw_script *s, vw_queue *q, bool settled, bool loading, double now_s, vw_script_step *out);
 
 // Key name ("ctrl+z", "f11", "?") to GLFW key code + modifiers; false when unknown.
 bool vw_key_from_name(const char *name, int *key, int *mods);
 
 // --- the viewer's state (viewer.c owns it; viewer_draw.c reads it and draws) -------------------------
 
+// The face loading on a thread: the file (or standard input for "-") fed piece by piece to an
+// rs_splat_loader. Between pieces the thread publishes a preview cloud of each LOD level that completes
+// (the first at once, then at most one every VW_PREVIEW_EVERY_S), which the frame loop shows while
+// the rest arrives; `cloud` is the whole face once `done`.
 typedef struct vw_loader {
     pthread_t thread;
     bool running;
-    atomic_bool done;
+    bool initial;                 // the face named on the command line: failing to load it is fatal
+    atomic_bool done, cancel;
     char path[512];
     rs_splat_cloud *cloud;
     rs_result result;
     rs_error err;
     double t0;
+    pthread_mutex_t mu;           // guards the three fields below
+    rs_splat_cloud *preview;      // the newest preview not yet taken by the frame loop
+    uint32_t decoded, count;      // progress for the loading line (splats)
 } vw_loader;
 
 // One step of the adaptive quality ladder: the LOD prefix drawn and the render resolution.
@@ -174,6 +185,7 @@ typedef struct vw_viewer {
     rs_paint_picker picker;
     char face_path[512];
     vw_loader load;
+    bool partial;  // the face shown is a preview of a file still loading: painting waits for the rest
 
     // Window (screen coordinates) and framebuffer (pixels).
     int win_w, win_h, fb_w, fb_h;

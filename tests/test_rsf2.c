@@ -583,6 +583,36 @@ static void test_loader_refuses_bytes_after_the_end(void)
     free(b);
 }
 
+// A stream that is no .rsf is refused at its first 12 bytes (not read to its end); a v1 stream may not
+// run past the length its header announces.
+static void test_stream_of_something_else_is_refused_at_once(void)
+{
+    rs_splat_loader *l = NULL;
+    rs_error err = {0};
+    static const uint8_t ply[16] = "ply\nformat asci";
+    RS_REQUIRE(rs_splat_loader_create(NULL, &l, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(rs_splat_loader_feed(l, ply, sizeof ply, &err) == RS_ERR_FORMAT && strstr(err.msg, "(stream): magic:"),
+             "not refused at once: %s", err.msg);
+    rs_splat_loader_destroy(l);
+    uint8_t v9[12] = {'R', 'S', 'F', 0, 9};
+    RS_REQUIRE(rs_splat_loader_create(NULL, &l, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(rs_splat_loader_feed(l, v9, sizeof v9, &err) == RS_ERR_FORMAT && strstr(err.msg, "unsupported version 9"),
+             "version 9: %s", err.msg);
+    rs_splat_loader_destroy(l);
+    void *v1 = NULL;
+    size_t l1 = 0;
+    rs_splat_cloud *c = smooth_cloud(10, 16, NULL);
+    RS_REQUIRE(rs_splat_save_memory_with(c, &(rs_splat_save_desc){.version = 1}, &v1, &l1, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_splat_loader_create(NULL, &l, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(rs_splat_loader_feed(l, v1, 100, &err) == RS_OK && rs_splat_loader_feed(l, (uint8_t *)v1 + 100, l1 - 100, &err) == RS_OK,
+             "%s", err.msg);
+    RS_CHECK(rs_splat_loader_feed(l, v1, 1, &err) == RS_ERR_FORMAT && strstr(err.msg, "more bytes than"), "past the end: %s",
+             err.msg);
+    rs_splat_loader_destroy(l);
+    free(v1);
+    rs_splat_destroy(c);
+}
+
 static void test_v1_stream_decodes_at_finish(void)
 {
     rs_splat_cloud *c = smooth_cloud(10, 9, NULL), *d = NULL;
@@ -694,6 +724,7 @@ int main(int argc, char **argv)
     RS_RUN(test_preview_is_the_prefix_with_scaled_radii);
     RS_RUN(test_loader_refuses_bytes_after_the_end);
     RS_RUN(test_v1_stream_decodes_at_finish);
+    RS_RUN(test_stream_of_something_else_is_refused_at_once);
     RS_RUN(test_quantized_normals_stay_within_0_05_degrees);
     RS_RUN(test_quantized_radii_stay_within_3_codes);
     return rs_test_finish();

@@ -27,7 +27,8 @@ tests="viewer_script_stroke_changes_only_the_painted_area viewer_undo_restores_t
 viewer_look_saved_and_loaded_renders_the_same viewer_records_a_replayable_stroke_file
 viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_one_line
 viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
-viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file"
+viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file
+viewer_streamed_face_draws_the_first_level_before_the_rest viewer_stdin_not_a_face_exits_with_one_line"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -200,6 +201,15 @@ if selected viewer_bad_face_exits_with_one_line; then
     else echo "ok - $name"; fi
 fi
 
+if selected viewer_stdin_not_a_face_exits_with_one_line; then
+    # Standard input that is not a face (rouge view - < /dev/zero): refused at its first bytes, not read on.
+    name=viewer_stdin_not_a_face_exits_with_one_line
+    timeout 60 "$rouge" view - --size 320x240 </dev/zero >"$out/stdin.out" 2>"$out/stdin.err"
+    rc=$?
+    if [ $rc -ne 1 ] || [ "$(wc -l <"$out/stdin.err")" -ne 1 ] || ! grep -q "^rouge: (standard input): magic:" "$out/stdin.err"
+    then echo "FAIL - $name: exit $rc: $(head -c 300 "$out/stdin.err")"
+    else echo "ok - $name"; fi
+fi
 if selected viewer_bad_event_script_names_the_line; then
     name=viewer_bad_event_script_names_the_line
     printf 'move 10 10\nidle\njump 3\n' >"$out/bad.events"
@@ -284,6 +294,51 @@ if selected viewer_s_saves_at_full_quality; then
         m=$("$imgdiff" "$out/s_early/rouge-0001.png" "$out/s_late/rouge-0001.png" 2>&1 | awk '/^max_abs/ {print $2}')
         if [ -n "$m" ] && [ "$m" -le 2 ]; then echo "ok - $name"
         else echo "FAIL - $name: the early shot differs from the refined one (max_abs ${m:-error})"; fi
+    fi
+fi
+if selected viewer_streamed_face_draws_the_first_level_before_the_rest; then
+    # The face as version 2 through a pipe (rouge view -): only the header and the coarsest LOD level's
+    # chunks are written at first; the rest is written only once the viewer has drawn and shot what it
+    # had, so that first picture was drawn before the whole file was even there, let alone decoded.
+    name=viewer_streamed_face_draws_the_first_level_before_the_rest
+    v2="$out/stream_face.rsf"
+    rm -f "$out/stream_first.png" "$out/stream_full.png" "$out/stream.fifo"
+    "$build/rouge-pack" "$face" -o "$v2" -q
+    first=$("$build/rouge-pack" --info "$v2" 2>/dev/null | awk '/first level/ {print $7}')
+    total=$(wc -c <"$v2")
+    if [ -z "$first" ] || [ "$first" -ge "$total" ]; then
+        echo "FAIL - $name: no first level in $v2 (rouge-pack --info: '$first' of $total bytes)"
+    else
+        mkfifo "$out/stream.fifo"
+        # The region above the loading line (spinner and text sit at the window's middle).
+        printf 'key i\nscreenshot %s 80 80 630 170\nloaded\nscreenshot %s 80 80 630 170\nquit\n' \
+            "$out/stream_first.png" "$out/stream_full.png" >"$out/stream.events"
+        timeout 180 "$rouge" view - --size 800x600 --max-splats 100000 --events "$out/stream.events" \
+            <"$out/stream.fifo" >"$out/stream.log" 2>&1 &
+        pid=$!
+        {
+            head -c "$first" "$v2"
+            i=0
+            while [ ! -s "$out/stream_first.png" ] && [ $i -lt 1500 ] && kill -0 $pid 2>/dev/null; do
+                sleep 0.1; i=$((i + 1))
+            done
+            # Only now the other ${total}-${first} bytes.
+            [ -s "$out/stream_first.png" ] && tail -c +"$((first + 1))" "$v2"
+        } >"$out/stream.fifo" 2>/dev/null
+        wait $pid
+        rc=$?
+        psnr=$("$imgdiff" "$out/stream_first.png" "$out/stream_full.png" 2>&1 | awk '/^psnr_db/ {print $2}')
+        frac=$("$imgdiff" "$out/stream_first.png" "$out/stream_full.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
+        if [ ! -s "$out/stream_first.png" ]; then
+            echo "FAIL - $name: nothing drawn from the first $first of $total bytes (exit $rc): $(tail -c 300 "$out/stream.log")"
+        elif [ $rc -ne 0 ] || [ ! -s "$out/stream_full.png" ]; then
+            echo "FAIL - $name: the rest did not load (exit $rc): $(tail -c 300 "$out/stream.log")"
+        elif ! awk -v p="$psnr" -v f="$frac" 'BEGIN { exit !(p != "" && p >= 20 && f != "" && f > 0) }'; then
+            echo "FAIL - $name: first level vs whole face: PSNR ${psnr:-?} dB (want >= 20: the same face), $frac of pixels over 8 (want > 0: refined) ($out/stream_first.png, stream_full.png)"
+        else
+            echo "ok - $name"
+            echo "# streamed face: drawn from $first of $total bytes; first level vs whole face PSNR $psnr dB, $frac of pixels over 8"
+        fi
     fi
 fi
 if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then

@@ -346,12 +346,19 @@ static bool reserve(rs_splat_loader *l, uint32_t n)
     return true;
 }
 
-// The first 12 bytes: magic, version (1 or anything else: kept whole for the v1 loader to judge),
-// header_size.
+// The first 12 bytes: magic, version (1: kept whole for the v1 loader; anything else refused at once,
+// with the v1 loader's words, so a stream of something else is not read to its end), header_size.
 static rs_result start(rs_splat_loader *l, const uint8_t *b, rs_error *err)
 {
     static const uint8_t magic[4] = {'R', 'S', 'F', 0};
-    if (memcmp(b, magic, 4) != 0 || rsf_rd_u32(b + RSF_OFF_VERSION) != RSF_VERSION_2) {
+    uint32_t version = rsf_rd_u32(b + RSF_OFF_VERSION);
+    if (memcmp(b, magic, 4) != 0 || (version != RSF_VERSION_1 && version != RSF_VERSION_2)) {
+        rs_splat_cloud *c = NULL;
+        rs_result r = rs_rsf1_load(b, 12, l->name, &c, err);
+        rs_splat_destroy(c);  // cannot load: 12 bytes are no file
+        return ld_keep(l, err, r != RS_OK ? r : RS_ERR_FORMAT);
+    }
+    if (version == RSF_VERSION_1) {
         l->st = LD_V1;
         return RS_OK;
     }
@@ -597,10 +604,15 @@ rs_result rs_splat_loader_feed(rs_splat_loader *l, const void *data, size_t len,
     const uint8_t *p = data;
     while (len > 0) {
         if (l->st == LD_V1) {
-            // Kept whole for the v1 loader, up to the largest file it accepts.
-            if (len > RSF_MAX_FILE_BYTES_V1 - l->have)
-                return ld_fail(l, err, RS_ERR_LIMIT, "%s: file: more than the %zu bytes an .rsf file may have", l->name,
-                               (size_t)RSF_MAX_FILE_BYTES_V1);
+            // Kept whole for the v1 loader, up to the length its header announces (the loader judges a
+            // shorter file) and the largest file it accepts.
+            uint64_t total = RSF_MAX_FILE_BYTES_V1;
+            if (l->have >= RSF_OFF_COUNT + 4)
+                total = RS_MIN(total, (uint64_t)rsf_rd_u32(l->buf + RSF_OFF_HEADER_SIZE) +
+                                          (uint64_t)rsf_rd_u32(l->buf + RSF_OFF_COUNT) * RSF_RECORD_SIZE + RSF_CRC_SIZE);
+            if (len > total - RS_MIN(total, (uint64_t)l->have))
+                return ld_fail(l, err, RS_ERR_FORMAT, "%s: file: more bytes than the %llu its header announces (byte %llu)",
+                               l->name, (unsigned long long)total, (unsigned long long)total);
             if (!ensure_buf(l, l->have + len)) return ld_fail(l, err, RS_ERR_NOMEM, "%s: out of memory", l->name);
             memcpy(l->buf + l->have, p, len);
             l->have += len;
