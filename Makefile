@@ -38,8 +38,8 @@ PROGS    := $(BUILD)/rouge $(TOOL_PROG:tools/rouge_%.c=$(BUILD)/rouge-%) $(BUILD
 
 # The library needs no window system: GLFW is the app's.
 LIB_PKGS := egl glesv2 libpng cglm libzstd
-LIB_LIBS := $(shell pkg-config --libs $(LIB_PKGS) 2>/dev/null) -lm
-LIBS := $(BUILD)/librouge.a $(PKG_LIBS) -lm
+LIB_LIBS := $(shell pkg-config --libs $(LIB_PKGS) 2>/dev/null) -lm -pthread
+LIBS := $(BUILD)/librouge.a $(PKG_LIBS) -lm -pthread
 # Tests also link the app's parts (UI, viewer, CLI) through libapp.a; the converter's tests libpack.
 TEST_LIBS := $(BUILD)/libapp.a $(LIBS)
 PACK_TESTS := test_pack test_ply test_import
@@ -193,7 +193,7 @@ install: $(INSTALL_PROGS) $(BUILD)/librouge.a $(BUILD)/$(SONAME)
 	ln -sf $(SONAME) $(I)/lib/librouge.so
 	printf '%s\n' 'prefix=$(PREFIX)' 'exec_prefix=$${prefix}' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	    'Name: rouge' 'Description: realistic skin rendering and makeup painting on face scans (OpenGL ES 3)' \
-	    'Version: $(VERSION)' 'Requires.private: $(LIB_PKGS)' 'Libs: -L$${libdir} -lrouge' 'Libs.private: -lm' \
+	    'Version: $(VERSION)' 'Requires.private: $(LIB_PKGS)' 'Libs: -L$${libdir} -lrouge' 'Libs.private: -lm -pthread' \
 	    'Cflags: -I$${includedir}' > $(I)/lib/pkgconfig/rouge.pc
 	install -m 644 assets/face.rsf assets/README.md $(I)/share/rouge/
 	install -d $(I)/share/rouge/env

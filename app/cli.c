@@ -1,6 +1,7 @@
 // cli.c — see cli.h.
 #include "cli.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -66,15 +67,6 @@ void rs_cli_print_options(FILE *f)
     }
 }
 
-static bool parse_float(const char *s, float *out)
-{
-    char *end;
-    double v = strtod(s, &end);
-    if (end == s || *end || !isfinite(v)) return false;
-    *out = (float)v;
-    return true;
-}
-
 static rs_result parse_enum(const char *name, const char *v, rs_cli *c, rs_error *err)
 {
     if (!strcmp(name, "--mode")) {
@@ -101,7 +93,10 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     rs_view *w = &c->view;
     float f = 0;
     if (o->kind == OPT_FLOAT || o->kind == OPT_INT) {
-        if (!parse_float(v, &f)) return rs_fail(err, RS_ERR_ARG, "%s: expected a number, got '%s'", o->name, v);
+        double d;
+        if (!rs_parse_number(v, -FLT_MAX, FLT_MAX, &d))
+            return rs_fail(err, RS_ERR_ARG, "%s: expected a number, got '%s'", o->name, v);
+        f = (float)d;
         if (f < o->lo || f > o->hi)
             return rs_fail(err, RS_ERR_ARG, "%s: %s is out of range %g..%g", o->name, v, o->lo, o->hi);
         if (o->kind == OPT_INT && f != floorf(f))
@@ -126,23 +121,23 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
         return RS_OK;
     }
     if (o->kind == OPT_PAN) {
-        float p[2];
-        char extra;
-        if (sscanf(v, "%f,%f%c", &p[0], &p[1], &extra) != 2 || !isfinite(p[0]) || !isfinite(p[1]) || p[0] < o->lo ||
-            p[0] > o->hi || p[1] < o->lo || p[1] > o->hi)
+        double p[2];
+        if (!rs_parse_list(v, ',', 2, o->lo, o->hi, p))
             return rs_fail(err, RS_ERR_ARG, "%s: expected X,Y within %g..%g, got '%s'", n, o->lo, o->hi, v);
-        w->pan[0] = p[0], w->pan[1] = p[1];
+        w->pan[0] = (float)p[0], w->pan[1] = (float)p[1];
         c->pan_set = true;
         return RS_OK;
     }
     if (o->kind == OPT_RGB) {
-        float rgb[3];
-        char extra;
-        if (sscanf(v, "%f,%f,%f%c", &rgb[0], &rgb[1], &rgb[2], &extra) != 3)
+        double d[3];
+        if (!rs_parse_list(v, ',', 3, -FLT_MAX, FLT_MAX, d))
             return rs_fail(err, RS_ERR_ARG, "%s: expected R,G,B, got '%s'", n, v);
-        for (int i = 0; i < 3; i++)
-            if (!isfinite(rgb[i]) || rgb[i] < o->lo || rgb[i] > o->hi)
+        float rgb[3];
+        for (int i = 0; i < 3; i++) {
+            if (d[i] < o->lo || d[i] > o->hi)
                 return rs_fail(err, RS_ERR_ARG, "%s: components must be %g..%g, got '%s'", n, o->lo, o->hi, v);
+            rgb[i] = (float)d[i];
+        }
         memcpy(!strcmp(n, "--background") ? w->background : w->key.color, rgb, sizeof rgb);
         return RS_OK;
     }

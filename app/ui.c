@@ -38,9 +38,11 @@ struct rs_ui {
     GLint u_fb, u_font, u_image;
     size_t vbo_bytes;
     vtx *v;
-    size_t nv, cap_v;
+    size_t nv;
+    uint32_t cap_v;
     batch *b;
-    size_t nb, cap_b;
+    size_t nb;
+    uint32_t cap_b;
     bool oom;  // a frame that could not grow its list draws what it has
 
     int fb_w, fb_h;
@@ -229,23 +231,12 @@ static void add_hit(rs_ui *ui, rs_ui_rect r)
 
 // --- the draw list ---------------------------------------------------------------------------------
 
-static bool grow(void **p, size_t *cap, size_t need, size_t elem)
-{
-    if (need <= *cap) return true;
-    size_t n = *cap ? *cap : 1024;
-    while (n < need) n *= 2;
-    void *q = realloc(*p, n * elem);
-    if (!q) return false;
-    *p = q, *cap = n;
-    return true;
-}
-
 // Appends 6 vertices to the batch for `image` (0: any batch will do) and returns them.
 static vtx *alloc6(rs_ui *ui, GLuint image)
 {
     if (ui->oom) return NULL;
-    if (!grow((void **)&ui->v, &ui->cap_v, ui->nv + 6, sizeof(vtx)) ||
-        !grow((void **)&ui->b, &ui->cap_b, ui->nb + 1, sizeof(batch))) {
+    if (!rs_array_grow((void **)&ui->v, &ui->cap_v, (uint32_t)ui->nv + 6, sizeof(vtx)) ||
+        !rs_array_grow((void **)&ui->b, &ui->cap_b, (uint32_t)ui->nb + 1, sizeof(batch))) {
         ui->oom = true;
         return NULL;
     }

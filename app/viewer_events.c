@@ -4,6 +4,8 @@
 #define _POSIX_C_SOURCE 200809L
 #include "viewer_internal.h"
 
+#include "formats/textfile.h"
+
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
 #include <ctype.h>
@@ -128,16 +130,6 @@ static rs_result add_event(parser *p, vw_event ev, bool advance)
     return add(p, &(vw_cmd){.type = VW_CMD_EVENT, .ev = ev, .advance = advance});
 }
 
-static bool num(const char *tok, double lo, double hi, double *out)
-{
-    if (!tok) return false;
-    char *end;
-    double v = strtod(tok, &end);
-    if (end == tok || *end || !isfinite(v) || v < lo || v > hi) return false;
-    *out = v;
-    return true;
-}
-
 static bool button_name(const char *tok, int *b)
 {
     if (!tok || !strcmp(tok, "left")) return *b = 0, true;
@@ -155,7 +147,7 @@ static rs_result parse_line(parser *p, char **tok, int n)
     rs_error *err = p->err;
 #define BAD(what) rs_fail(err, RS_ERR_FORMAT, "%s:%d: %s: %s", p->file, p->line, c, what)
     if (!strcmp(c, "move") || !strcmp(c, "click")) {
-        if (n != 3 || !num(tok[1], -COORD_MAX, COORD_MAX, &a[0]) || !num(tok[2], -COORD_MAX, COORD_MAX, &a[1]))
+        if (n != 3 || !rs_parse_number(tok[1], -COORD_MAX, COORD_MAX, &a[0]) || !rs_parse_number(tok[2], -COORD_MAX, COORD_MAX, &a[1]))
             return BAD("expected X Y");
         vw_event ev = {.type = VW_MOVE, .x = (float)a[0], .y = (float)a[1]};
         rs_result r = add_event(p, ev, true);
@@ -174,11 +166,11 @@ static rs_result parse_line(parser *p, char **tok, int n)
     if (!strcmp(c, "drag")) {
         if (n < 5 || n > 7) return BAD("expected X0 Y0 X1 Y1 [STEPS] [BUTTON]");
         for (int i = 0; i < 4; i++)
-            if (!num(tok[1 + i], -COORD_MAX, COORD_MAX, &a[i])) return BAD("coordinates must be numbers");
+            if (!rs_parse_number(tok[1 + i], -COORD_MAX, COORD_MAX, &a[i])) return BAD("coordinates must be numbers");
         double steps = 20;
         int b = 0, k = 5;
         if (n > k && isdigit((unsigned char)tok[k][0])) {
-            if (!num(tok[k], 1, 10000, &steps) || steps != floor(steps)) return BAD("STEPS must be 1..10000");
+            if (!rs_parse_number(tok[k], 1, 10000, &steps) || steps != floor(steps)) return BAD("STEPS must be 1..10000");
             k++;
         }
         if (n > k && !button_name(tok[k], &b)) return BAD("button must be left, right or middle");
@@ -195,7 +187,7 @@ static rs_result parse_line(parser *p, char **tok, int n)
         return r;
     }
     if (!strcmp(c, "scroll")) {
-        if (n != 2 || !num(tok[1], -100, 100, &a[0])) return BAD("expected DY (-100..100)");
+        if (n != 2 || !rs_parse_number(tok[1], -100, 100, &a[0])) return BAD("expected DY (-100..100)");
         return add_event(p, (vw_event){.type = VW_SCROLL, .dy = (float)a[0]}, true);
     }
     if (!strcmp(c, "key")) {
@@ -206,13 +198,13 @@ static rs_result parse_line(parser *p, char **tok, int n)
         return add_event(p, (vw_event){.type = VW_KEY, .key = key, .mods = mods}, true);
     }
     if (!strcmp(c, "touch")) {
-        if (n != 5 || !num(tok[1], 1, 9, &a[0]) || a[0] != floor(a[0])) return BAD("expected ID (1..9) down|move|up X Y");
+        if (n != 5 || !rs_parse_number(tok[1], 1, 9, &a[0]) || a[0] != floor(a[0])) return BAD("expected ID (1..9) down|move|up X Y");
         rs_input_type t;
         if (!strcmp(tok[2], "down")) t = RS_INPUT_DOWN;
         else if (!strcmp(tok[2], "move")) t = RS_INPUT_MOVE;
         else if (!strcmp(tok[2], "up")) t = RS_INPUT_UP;
         else return BAD("expected down, move or up");
-        if (!num(tok[3], -COORD_MAX, COORD_MAX, &a[1]) || !num(tok[4], -COORD_MAX, COORD_MAX, &a[2]))
+        if (!rs_parse_number(tok[3], -COORD_MAX, COORD_MAX, &a[1]) || !rs_parse_number(tok[4], -COORD_MAX, COORD_MAX, &a[2]))
             return BAD("coordinates must be numbers");
         return add_event(p, (vw_event){.type = VW_TOUCH, .id = (int)a[0], .touch = t, .x = (float)a[1], .y = (float)a[2]},
                          true);
@@ -220,7 +212,7 @@ static rs_result parse_line(parser *p, char **tok, int n)
     if (!strcmp(c, "screenshot") && n == 6) {
         vw_cmd cmd = {.type = VW_CMD_SCREENSHOT};
         for (int i = 0; i < 4; i++)
-            if (!num(tok[2 + i], i < 2 ? 0 : 1, COORD_MAX, &a[i]) || a[i] != floor(a[i]))
+            if (!rs_parse_number(tok[2 + i], i < 2 ? 0 : 1, COORD_MAX, &a[i]) || a[i] != floor(a[i]))
                 return BAD("region X Y W H must be whole numbers, W and H at least 1");
         if (strlen(tok[1]) >= sizeof cmd.path) return BAD("file name too long");
         snprintf(cmd.path, sizeof cmd.path, "%s", tok[1]);
@@ -240,11 +232,11 @@ static rs_result parse_line(parser *p, char **tok, int n)
         return add(p, &cmd);
     }
     if (!strcmp(c, "step") || !strcmp(c, "wait")) {
-        if (n != 2 || !num(tok[1], 0, 3600, &a[0])) return BAD("expected seconds (0..3600)");
+        if (n != 2 || !rs_parse_number(tok[1], 0, 3600, &a[0])) return BAD("expected seconds (0..3600)");
         return add(p, &(vw_cmd){.type = c[0] == 's' ? VW_CMD_STEP : VW_CMD_WAIT, .value = a[0]});
     }
     if (!strcmp(c, "frames")) {
-        if (n != 2 || !num(tok[1], 1, 1e6, &a[0]) || a[0] != floor(a[0])) return BAD("expected a count (1..1000000)");
+        if (n != 2 || !rs_parse_number(tok[1], 1, 1e6, &a[0]) || a[0] != floor(a[0])) return BAD("expected a count (1..1000000)");
         return add(p, &(vw_cmd){.type = VW_CMD_FRAMES, .value = a[0]});
     }
     if (!strcmp(c, "idle") || !strcmp(c, "quit") || !strcmp(c, "loaded")) {
@@ -265,33 +257,29 @@ rs_result vw_script_load(const char *path, vw_script *out, rs_error *err)
     vw_script s = {.step_s = 1.0 / 60.0};
     snprintf(s.name, sizeof s.name, "%s", path);
     parser p = {.s = &s, .file = path, .err = err};
-    const char *text = data, *end = text + len;
-    while (text < end && !r) {
-        p.line++;
-        const char *nl = memchr(text, '\n', (size_t)(end - text));
-        size_t n = nl ? (size_t)(nl - text) : (size_t)(end - text);
-        char buf[1024];
-        if (n >= sizeof buf) {
-            r = rs_fail(err, RS_ERR_FORMAT, "%s:%d: line longer than %zu bytes", path, p.line, sizeof buf - 1);
-            break;
-        }
-        memcpy(buf, text, n);
-        buf[n] = 0;
-        text += n + (nl ? 1 : 0);
-        char *hash = strchr(buf, '#');
+    rs_text_reader t = {.data = data, .len = len};
+    char buf[1024], *line;
+    rs_result rr = RS_OK;  // the line reader's own failure ("line N: ...")
+    while (!r && rs_text_next_line(&t, buf, sizeof buf, &line, &rr, err)) {
+        p.line = (int)t.line;
+        char *hash = strchr(line, '#');
         if (hash) *hash = 0;
         char *tok[8];
         int nt = 0;
-        for (char *t = strtok(buf, " \t\r"); t; t = strtok(NULL, " \t\r")) {
+        for (char *w = strtok(line, " \t\r"); w; w = strtok(NULL, " \t\r")) {
             if (nt == 8) {
                 r = rs_fail(err, RS_ERR_FORMAT, "%s:%d: too many values", path, p.line);
                 break;
             }
-            tok[nt++] = t;
+            tok[nt++] = w;
         }
         if (!r && nt) r = parse_line(&p, tok, nt);
     }
     free(data);
+    if (rr) {
+        rs_error inner = *err;
+        r = rs_fail(err, rr, "%s: %s", path, inner.msg);
+    }
     if (r) {
         free(s.cmd);
         return r;

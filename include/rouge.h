@@ -282,8 +282,13 @@ rouge_result rouge_face_load_look_memory(rouge_face *face, const void *data, siz
 rouge_result rouge_face_save_look(rouge_face *face, const char *path, rouge_error *err);
 // *data (free with rouge_free) holds *size bytes of look text.
 rouge_result rouge_face_save_look_memory(rouge_face *face, char **data, size_t *size, rouge_error *err);
-// Records each stroke painted from now on to a stroke file (saved after every stroke); NULL stops.
+// Records each stroke painted from now on to a stroke file; NULL stops. After every stroke the whole
+// recording is rewritten atomically on a background thread (never a half-written file, and no disk wait
+// on the pointer path); a failed write is returned by a later rouge_face_pointer, rouge_face_flush_strokes
+// or rouge_face_record_strokes call. Stopping (or destroying the face) writes what is pending first.
 rouge_result rouge_face_record_strokes(rouge_face *face, const char *path, rouge_error *err);
+// Waits until every finished stroke is in the recording's file; returns a write failure, if any.
+rouge_result rouge_face_flush_strokes(rouge_face *face, rouge_error *err);
 // Replays a stroke file (each stroke seen through the camera it was recorded with); the camera is
 // left at the last stroke's.
 rouge_result rouge_face_play_strokes(rouge_face *face, const char *path, rouge_error *err);

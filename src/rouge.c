@@ -16,6 +16,7 @@
 #include "splat/splat.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,6 +36,110 @@ _Static_assert(sizeof(((rouge_error *)0)->msg) == sizeof(((rs_error *)0)->msg), 
 #define ZOOM_MAX 12.0f
 #define MAX_TEXTURE_UNITS 8  // the renderer uses units 0..RS_UNIT_LEVEL (render_internal.h)
 
+// A stroke recording is rewritten whole after each stroke (temp file, fsync, rename: the file on disk is
+// always a complete recording). The writing happens on this thread, so ending a stroke costs only turning
+// the document into text; a newer text supersedes one not yet written. Failures are reported by the next
+// rouge_face_pointer / rouge_face_flush_strokes / rouge_face_record_strokes call.
+typedef struct rec_writer {
+    pthread_t thread;
+    pthread_mutex_t mu;
+    pthread_cond_t cv;   // signalled on new text, on quit and when a write finishes
+    char *path;
+    char *pending;       // the newest text not yet taken by the thread (NULL: none)
+    size_t pending_len;
+    bool busy, quit;
+    rs_result result;    // the last failed write, until reported
+    rs_error error;
+} rec_writer;
+
+static void *rec_thread(void *arg)
+{
+    rec_writer *w = arg;
+    pthread_mutex_lock(&w->mu);
+    for (;;) {
+        while (!w->pending && !w->quit) pthread_cond_wait(&w->cv, &w->mu);
+        if (!w->pending) break;  // quit, and everything is written
+        char *text = w->pending;
+        size_t len = w->pending_len;
+        w->pending = NULL;
+        w->busy = true;
+        pthread_mutex_unlock(&w->mu);
+        rs_error e = {0};
+        rs_result r = rs_file_write_atomic(w->path, text, len, &e);
+        free(text);
+        pthread_mutex_lock(&w->mu);
+        w->busy = false;
+        if (r && !w->result) w->result = r, w->error = e;
+        pthread_cond_broadcast(&w->cv);
+    }
+    pthread_mutex_unlock(&w->mu);
+    return NULL;
+}
+
+static rs_result rec_writer_start(const char *path, rec_writer **out, rs_error *e)
+{
+    rec_writer *w = calloc(1, sizeof *w);
+    size_t n = strlen(path) + 1;
+    if (!w || !(w->path = malloc(n))) {
+        free(w);
+        return rs_fail(e, RS_ERR_NOMEM, "strokes: out of memory");
+    }
+    memcpy(w->path, path, n);
+    pthread_mutex_init(&w->mu, NULL);
+    pthread_cond_init(&w->cv, NULL);
+    if (pthread_create(&w->thread, NULL, rec_thread, w) != 0) {
+        pthread_cond_destroy(&w->cv);
+        pthread_mutex_destroy(&w->mu);
+        free(w->path);
+        free(w);
+        return rs_fail(e, RS_ERR_NOMEM, "strokes: cannot start the writer thread");
+    }
+    *out = w;
+    return RS_OK;
+}
+
+// Hands the newest text to the thread (taking ownership of it).
+static void rec_writer_submit(rec_writer *w, char *text, size_t len)
+{
+    pthread_mutex_lock(&w->mu);
+    free(w->pending);
+    w->pending = text, w->pending_len = len;
+    pthread_cond_broadcast(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+}
+
+// The last failure since the previous call (and clears it); with `wait`, first waits until every
+// submitted text is on disk.
+static rs_result rec_writer_status(rec_writer *w, bool wait, rs_error *e)
+{
+    pthread_mutex_lock(&w->mu);
+    while (wait && (w->pending || w->busy)) pthread_cond_wait(&w->cv, &w->mu);
+    rs_result r = w->result;
+    if (r) *e = w->error;
+    w->result = RS_OK;
+    pthread_mutex_unlock(&w->mu);
+    return r;
+}
+
+// Writes what is pending, stops the thread and frees the writer; returns the last failure.
+static rs_result rec_writer_stop(rec_writer *w, rs_error *e)
+{
+    if (!w) return RS_OK;
+    pthread_mutex_lock(&w->mu);
+    w->quit = true;
+    pthread_cond_broadcast(&w->cv);
+    pthread_mutex_unlock(&w->mu);
+    pthread_join(w->thread, NULL);
+    rs_result r = w->result;
+    if (r) *e = w->error;
+    pthread_cond_destroy(&w->cv);
+    pthread_mutex_destroy(&w->mu);
+    free(w->pending);
+    free(w->path);
+    free(w);
+    return r;
+}
+
 struct rouge_face {
     rs_splat_cloud *cloud;
     rs_renderer *ren;
@@ -49,7 +154,7 @@ struct rouge_face {
     bool changed;                 // view or makeup changed since the last frame
     bool manual_navigation, painting;
     rs_strokes *rec;              // stroke recording (rouge_face_record_strokes)
-    char *rec_path;
+    rec_writer *writer;           // writes it to its file off the pointer path
     uint32_t uploaded;            // records uploaded for the last frame
 };
 
@@ -507,8 +612,9 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
 void rouge_face_destroy(rouge_face *f)
 {
     if (!f) return;
+    rs_error ignored = {0};
+    rec_writer_stop(f->writer, &ignored);
     rs_strokes_destroy(f->rec);
-    free(f->rec_path);
     free(f->env_dir);
     rs_paint_destroy(f->paint);
     rs_makeup_destroy(f->mk);
@@ -703,7 +809,13 @@ rouge_result rouge_face_pointer(rouge_face *f, const rouge_pointer_event *ev, ro
         if (res.pan_dx_px != 0 || res.pan_dy_px != 0) rouge_face_pan(f, res.pan_dx_px, res.pan_dy_px);
         if (res.zoom > 0 && res.zoom != 1.0f) rouge_face_zoom_at(f, res.zoom, res.zoom_cx_px, res.zoom_cy_px);
     }
-    if (!r && res.stroke_end && f->rec) r = rs_strokes_save(f->rec, f->rec_path, &e);
+    if (!r && res.stroke_end && f->rec) {
+        char *text = NULL;
+        size_t len = 0;
+        r = rs_strokes_write_memory(f->rec, &text, &len, &e);
+        if (!r) rec_writer_submit(f->writer, text, len);
+    }
+    if (!r && f->writer) r = rec_writer_status(f->writer, false, &e);
     if (out)
         *out = (rouge_pointer_result){.stamps = res.stamps, .misses = res.misses, .stroke_begin = res.stroke_begin,
                                       .stroke_end = res.stroke_end, .stroke_cancel = res.stroke_cancel,
@@ -780,18 +892,26 @@ rouge_result rouge_face_record_strokes(rouge_face *f, const char *path, rouge_er
 {
     rs_error e = {0};
     rs_paint_set_recorder(f->paint, NULL, NULL);
+    rs_result stopped = rec_writer_stop(f->writer, &e);
     rs_strokes_destroy(f->rec);
-    free(f->rec_path);
-    free(f->env_dir);
-    f->rec = NULL, f->rec_path = NULL;
+    f->rec = NULL, f->writer = NULL;
+    if (stopped) return fail_out(err, &e);
     if (!path) return ROUGE_OK;
-    f->rec_path = malloc(strlen(path) + 1);
-    if (!f->rec_path) return rs_fail(&e, RS_ERR_NOMEM, "out of memory"), fail_out(err, &e);
-    strcpy(f->rec_path, path);
     if (rs_strokes_create(&f->rec, &e) != RS_OK) return fail_out(err, &e);
+    if (rec_writer_start(path, &f->writer, &e) != RS_OK) {
+        rs_strokes_destroy(f->rec);
+        f->rec = NULL;
+        return fail_out(err, &e);
+    }
     rs_strokes_view sv = strokes_view(pointer_view(f));
     rs_paint_set_recorder(f->paint, f->rec, &sv);
     return ROUGE_OK;
+}
+
+rouge_result rouge_face_flush_strokes(rouge_face *f, rouge_error *err)
+{
+    rs_error e = {0};
+    return f->writer && rec_writer_status(f->writer, true, &e) ? fail_out(err, &e) : ROUGE_OK;
 }
 
 rouge_result rouge_face_play_strokes(rouge_face *f, const char *path, rouge_error *err)

@@ -2,6 +2,7 @@
 #include "support/harness.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static const char *clean(const char *in, size_t cap)
@@ -57,6 +58,38 @@ static void test_srgb_threshold_and_round_trip(void)
     RS_CHECK(rs_linear_to_srgb(-1) == 0 && fabsf(rs_linear_to_srgb(2) - 1.0f) < 1e-6f, "not clamped");
 }
 
+// The one number parser: whole tokens only, finite, in range; lists need exactly n numbers.
+static void test_parse_number_and_lists(void)
+{
+    double v = 0, l[3] = {0};
+    float f = 0;
+    RS_CHECK(rs_parse_number("2.5", 0, 10, &v) && v == 2.5, "2.5");
+    RS_CHECK(rs_parse_number("-1e-3", -1, 1, &v) && v == -1e-3, "-1e-3");
+    const char *bad[] = {"", " 1", "1 ", "1x", "nan", "inf", "1e999", "0x", NULL};
+    for (int i = 0; i < (int)(sizeof bad / sizeof *bad); i++)
+        RS_CHECK(!rs_parse_number(bad[i], -1e300, 1e300, &v), "'%s' refused", bad[i] ? bad[i] : "(null)");
+    RS_CHECK(!rs_parse_number("11", 0, 10, &v) && !rs_parse_number("-0.1", 0, 10, &v), "range");
+    RS_CHECK(rs_parse_float("3.25", &f) && f == 3.25f && !rs_parse_float("1e39", &f), "float range");
+    RS_CHECK(rs_parse_list("0.1,-0.2", ',', 2, -1, 1, l) && l[0] == 0.1 && l[1] == -0.2, "pair");
+    RS_CHECK(rs_parse_list("1,2,3", ',', 3, 0, 3, l) && l[2] == 3, "triple");
+    RS_CHECK(!rs_parse_list("1,2", ',', 3, 0, 3, l) && !rs_parse_list("1,2,3,4", ',', 3, 0, 9, l) &&
+                 !rs_parse_list("1,,3", ',', 3, 0, 3, l) && !rs_parse_list("1,2,5", ',', 3, 0, 3, l),
+             "short, long, empty and out-of-range lists refused");
+}
+
+// Growth doubles from 64, keeps contents, refuses sizes that overflow and leaves the array as it was.
+static void test_array_grow(void)
+{
+    uint32_t *a = NULL, cap = 0;
+    RS_CHECK(rs_array_grow((void **)&a, &cap, 1, sizeof *a) && cap == 64, "first growth to 64 (cap %u)", cap);
+    for (uint32_t i = 0; i < 64; i++) a[i] = i;
+    RS_CHECK(rs_array_grow((void **)&a, &cap, 300, sizeof *a) && cap == 512 && a[63] == 63, "grows to 512 keeping data");
+    uint32_t *keep = a, kc = cap;
+    RS_CHECK(!rs_array_grow((void **)&a, &cap, UINT32_MAX, (size_t)1 << 40) && a == keep && cap == kc,
+             "an overflowing size is refused and the array kept");
+    free(a);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -66,5 +99,7 @@ int main(int argc, char **argv)
     RS_RUN(test_sanitize_cuts_whole_characters);
     RS_RUN(test_errors_are_sanitised);
     RS_RUN(test_srgb_threshold_and_round_trip);
+    RS_RUN(test_parse_number_and_lists);
+    RS_RUN(test_array_grow);
     return rs_test_finish();
 }

@@ -7,6 +7,7 @@
 #include "support/harness.h"
 #include "gl/gl.h"
 #include "formats/env_lookup.h"
+#include "formats/strokes.h"
 #include "render/render.h"
 #include "rouge.h"
 
@@ -241,6 +242,56 @@ out:
     rs_image_free(&looked);
 }
 
+// The recording is written by a background thread: after a flush the file holds every stroke; a write
+// that fails comes back from the flush with the file's name; a face made with an environment folder
+// survives recording and destruction (record_strokes once freed that folder's name).
+static void test_stroke_recording(void)
+{
+    rouge_view v = small_view();
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .size = 0.15f, .opacity = 1}, &e) == ROUGE_OK,
+               "%s", e.msg);
+    rs_image img = {0};
+    if (!frame(&img)) return;  // picks refer to the last frame
+    rs_image_free(&img);
+    const char *dir = getenv("RS_TEST_OUT");
+    char path[512], bad[600];
+    snprintf(path, sizeof path, "%s/test_face_recording.strokes", dir ? dir : "/tmp");
+    snprintf(bad, sizeof bad, "%s/no/such/dir/x.strokes", dir ? dir : "/tmp");
+    remove(path);
+    RS_REQUIRE(rouge_face_record_strokes(face, path, &e) == ROUGE_OK, "record: %s", e.msg);
+    rouge_pointer_result res;
+    for (int i = 0; i < 3; i++)
+        RS_CHECK(stroke(SIZE * 0.35f, SIZE * (0.5f + 0.05f * (float)i), SIZE * 0.65f, SIZE * 0.6f, &res) == ROUGE_OK,
+                 "stroke %d", i);
+    RS_CHECK(rouge_face_flush_strokes(face, &e) == ROUGE_OK, "flush: %s", e.msg);
+    rs_strokes *doc = NULL;
+    rs_error re = {0};
+    if (RS_CHECK(rs_strokes_load(path, &doc, &re) == RS_OK, "load the recording: %s", re.msg))
+        RS_CHECK(doc->count == 3, "the recording holds %u strokes, want 3", doc->count);
+    rs_strokes_destroy(doc);
+    RS_CHECK(rouge_face_record_strokes(face, bad, &e) == ROUGE_OK, "record to %s: %s", bad, e.msg);
+    RS_CHECK(stroke(SIZE * 0.35f, SIZE * 0.6f, SIZE * 0.65f, SIZE * 0.6f, &res) == ROUGE_OK || e.msg[0], "stroke");
+    rouge_result fr = rouge_face_flush_strokes(face, &e);
+    if (fr == ROUGE_OK) fr = rouge_face_record_strokes(face, NULL, &e);  // the error may have come with the stroke
+    RS_CHECK(fr == ROUGE_ERR_IO || strstr(e.msg, "x.strokes"), "a failed write is reported: %d %s", fr, e.msg);
+    RS_CHECK(rouge_face_record_strokes(face, NULL, &e) == ROUGE_OK, "stop after the reported failure: %s", e.msg);
+    rouge_face_clear(face, NULL);
+
+    rouge_face *g = NULL;
+    rouge_view gv = small_view();
+    gv.max_splats = 2000;
+    if (!RS_CHECK(rouge_face_create(&(rouge_face_desc){.path = FACE, .view = &gv, .env_dir = "assets/env"}, &g, &e) ==
+                      ROUGE_OK,
+                  "face with env_dir: %s", e.msg))
+        return;
+    RS_CHECK(rouge_face_record_strokes(g, path, &e) == ROUGE_OK && rouge_face_record_strokes(g, NULL, &e) == ROUGE_OK,
+             "record on a face with env_dir: %s", e.msg);
+    RS_CHECK(rouge_face_render(g, &e) == ROUGE_OK, "render after recording: %s", e.msg);
+    rouge_face_destroy(g);
+}
+
 static void test_errors_are_values(void)
 {
     rouge_error e = {0};
@@ -339,6 +390,7 @@ int main(int argc, char **argv)
     RS_RUN(test_zero_view_is_the_default_view);
     RS_RUN(test_draw_into_host_framebuffer_restores_state);
     RS_RUN(test_paint_undo_redo_and_look_in_memory);
+    RS_RUN(test_stroke_recording);
     RS_RUN(test_errors_are_values);
     RS_RUN(test_target_centres_each_region);
     RS_RUN(test_pan_shifts_the_picture);

@@ -29,8 +29,8 @@ static uint64_t rng_u64(void)
 
 static double rng_unit(void) { return (double)(rng_u64() >> 11) * (1.0 / 9007199254740992.0); }
 
-static uint32_t get_u32(const uint8_t *b, size_t off) { return rsf_rd_u32(b + off); }
-static void put_u32(uint8_t *b, size_t off, uint32_t v) { rsf_wr_u32(b + off, v); }
+static uint32_t get_u32(const uint8_t *b, size_t off) { return rs_le32_get(b + off); }
+static void put_u32(uint8_t *b, size_t off, uint32_t v) { rs_le32_put(b + off, v); }
 
 // A smooth, scan-like cloud: an ellipsoid sampled row by row (neighbours in the file are neighbours on
 // the surface, as in a converter's Morton order), colours and normals varying slowly, LOD levels of

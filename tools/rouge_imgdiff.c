@@ -35,17 +35,6 @@ static int die(const char *msg)
     return 2;
 }
 
-// Parses all of s as a finite double in [lo, hi].
-static bool parse_num(const char *s, double lo, double hi, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) return false;
-    *out = v;
-    return true;
-}
-
 int main(int argc, char **argv)
 {
     const char *paths[2] = { 0 }, *diff_path = NULL;
@@ -66,7 +55,7 @@ int main(int argc, char **argv)
         }
         double v;
         if (!strcmp(a, "--threshold")) {
-            if (!parse_num(argv[++i], 0, 255, &v) || v != floor(v)) {
+            if (!rs_parse_number(argv[++i], 0, 255, &v) || v != floor(v)) {
                 snprintf(msg, sizeof msg, "--threshold '%s': expected an integer 0..255", argv[i]);
                 return die(msg);
             }
@@ -74,12 +63,12 @@ int main(int argc, char **argv)
         } else if (!strcmp(a, "--diff")) {
             diff_path = argv[++i];
         } else if (!strcmp(a, "--max-frac")) {
-            if (!parse_num(argv[++i], 0, 1, &max_frac)) {
+            if (!rs_parse_number(argv[++i], 0, 1, &max_frac)) {
                 snprintf(msg, sizeof msg, "--max-frac '%s': expected a number 0..1", argv[i]);
                 return die(msg);
             }
         } else if (!strcmp(a, "--min-psnr")) {
-            if (!parse_num(argv[++i], -HUGE_VAL, HUGE_VAL, &min_psnr)) {
+            if (!rs_parse_number(argv[++i], -HUGE_VAL, HUGE_VAL, &min_psnr)) {
                 snprintf(msg, sizeof msg, "--min-psnr '%s': expected a number of dB", argv[i]);
                 return die(msg);
             }

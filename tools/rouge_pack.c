@@ -100,12 +100,11 @@ static bool parse_u64(const char *s, uint64_t lo, uint64_t hi, uint64_t *out)
     return true;
 }
 
-static bool parse_float(const char *s, float *out)
+// A scale factor: a number > 0 (and at most 1e30).
+static bool parse_scale(const char *s, float *out)
 {
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || !(v > 0) || v > 1e30) return false;
+    double v;
+    if (!rs_parse_number(s, 0.0, 1e30, &v) || !(v > 0)) return false;
     *out = (float)v;
     return true;
 }
@@ -167,13 +166,13 @@ static uint64_t first_level_bytes(const char *path)
 // The version field of a file that has just loaded (bytes 4..7, little-endian).
 static unsigned file_version(const char *path)
 {
-    unsigned char b[8] = {0};
+    uint8_t b[8] = {0};
     FILE *f = fopen(path, "rb");
     if (f) {
         if (fread(b, 1, sizeof b, f) != sizeof b) memset(b, 0, sizeof b);
         fclose(f);
     }
-    return (unsigned)b[4] | (unsigned)b[5] << 8 | (unsigned)b[6] << 16 | (unsigned)b[7] << 24;
+    return rs_le32_get(b + 4);
 }
 
 static int info(const char *path, const char *preview)
@@ -284,7 +283,7 @@ static int recompute_ao(const char *path, const char *output, bool quiet)
     rs_splat_cloud *c = NULL;
     if (rs_splat_load(path, &c, &err) != RS_OK) return fail(1, "%s", err.msg);
     // The version field (bytes 4..7, little-endian) of a file that just loaded.
-    unsigned char b[8] = {0};
+    uint8_t b[8] = {0};
     FILE *f = fopen(path, "rb");
     size_t got = f ? fread(b, 1, sizeof b, f) : 0;
     if (f) fclose(f);
@@ -551,7 +550,7 @@ int main(int argc, char **argv)
             if (!(o.desc.mm_per_unit = rs_pack_unit_parse(v))) return fail(2, "--units: expected mm, cm, m or in, got '%s'", v);
             o.units = v;
         } else if (!strcmp(a, "--mm-per-unit")) {
-            if (!parse_float(v, &o.desc.mm_per_unit)) return fail(2, "--mm-per-unit: expected a number > 0, got '%s'", v);
+            if (!parse_scale(v, &o.desc.mm_per_unit)) return fail(2, "--mm-per-unit: expected a number > 0, got '%s'", v);
             mm_given = true;
         } else if (!strcmp(a, "--up") || !strcmp(a, "--forward")) {
             rs_pack_axis ax = rs_pack_axis_parse(v);

@@ -33,16 +33,6 @@ static int die(const char *msg)
     return 2;
 }
 
-static bool parse_num(const char *s, double lo, double hi, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(s, &end);
-    if (end == s || *end || errno || !isfinite(v) || v < lo || v > hi) return false;
-    *out = v;
-    return true;
-}
-
 static void print_row(const char *name, const rs_profile *p, int channel)
 {
     printf("  %-14s", name);
@@ -94,12 +84,12 @@ int main(int argc, char **argv)
             fputs(usage, stdout);
             return 0;
         } else if (!strcmp(a, "--k") && next) {
-            if (!parse_num(next, RS_PROFILE_FIT_MIN, RS_PROFILE_FIT_MAX, &v) || v != floor(v))
+            if (!rs_parse_number(next, RS_PROFILE_FIT_MIN, RS_PROFILE_FIT_MAX, &v) || v != floor(v))
                 return die("--k: want an integer 2..5");
             k = (int)v;
             i++;
         } else if (!strcmp(a, "--footprint") && next) {
-            if (!parse_num(next, 0.0, 10.0, &footprint_mm)) return die("--footprint: want mm in 0..10");
+            if (!rs_parse_number(next, 0.0, 10.0, &footprint_mm)) return die("--footprint: want mm in 0..10");
             i++;
         } else if (!strcmp(a, "--objective") && next) {
             edge = !strcmp(next, "edge") || !strcmp(next, "both");

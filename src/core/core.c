@@ -3,9 +3,11 @@
 #define _GNU_SOURCE
 #include "core/core.h"
 
+#include <ctype.h>
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <float.h>
 #include <math.h>
 #include <signal.h>
 #include <stdarg.h>
@@ -300,4 +302,51 @@ void rs_lef32_put(uint8_t *p, float f)
     uint32_t u;
     memcpy(&u, &f, sizeof u);
     rs_le32_put(p, u);
+}
+
+bool rs_parse_number(const char *s, double lo, double hi, double *out)
+{
+    if (!s || !*s || isspace((unsigned char)*s)) return false;
+    char *end;
+    errno = 0;
+    double v = strtod(s, &end);
+    if (end == s || *end || errno == ERANGE || !isfinite(v) || v < lo || v > hi) return false;
+    *out = v;
+    return true;
+}
+
+bool rs_parse_float(const char *s, float *out)
+{
+    double v;
+    if (!rs_parse_number(s, -FLT_MAX, FLT_MAX, &v)) return false;
+    *out = (float)v;
+    return true;
+}
+
+bool rs_parse_list(const char *s, char sep, int n, double lo, double hi, double *out)
+{
+    char tok[64];
+    for (int k = 0; k < n; k++) {
+        const char *end = k + 1 < n ? strchr(s, sep) : s + strlen(s);
+        if (!end || (size_t)(end - s) >= sizeof tok) return false;
+        memcpy(tok, s, (size_t)(end - s));
+        tok[end - s] = 0;
+        if (!rs_parse_number(tok, lo, hi, &out[k])) return false;
+        s = end + 1;
+    }
+    return true;
+}
+
+bool rs_array_grow(void **ptr, uint32_t *cap, uint32_t need, size_t elem)
+{
+    if (need <= *cap) return true;
+    uint64_t c = RS_MAX((uint64_t)*cap * 2, 64u);
+    while (c < need) c *= 2;
+    size_t bytes;
+    if (c > UINT32_MAX || !rs_size_mul((size_t)c, elem, &bytes)) return false;
+    void *q = realloc(*ptr, bytes);
+    if (!q) return false;
+    *ptr = q;
+    *cap = (uint32_t)c;
+    return true;
 }

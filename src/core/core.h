@@ -56,6 +56,17 @@ bool rs_size_add(size_t a, size_t b, size_t *out);
 // malloc(a*b) with an overflow check; NULL on overflow or out of memory.
 void *rs_alloc_array(size_t count, size_t elem_size);
 
+// All of s as one finite number in [lo, hi] (strtod syntax; no blanks or characters before or after):
+// the one number parser of rouge's command lines, scripts and text formats. False otherwise, *out untouched.
+bool rs_parse_number(const char *s, double lo, double hi, double *out);
+// Any finite float (what rouge's text formats store).
+bool rs_parse_float(const char *s, float *out);
+// Exactly n numbers separated by `sep` ("0.1,-0.2"), each as rs_parse_number takes it.
+bool rs_parse_list(const char *s, char sep, int n, double lo, double hi, double *out);
+// Grows *ptr to hold at least `need` elements of `elem` bytes: capacity doubles (from 64), sizes are
+// checked, and on failure *ptr and *cap are left as they were.
+bool rs_array_grow(void **ptr, uint32_t *cap, uint32_t need, size_t elem);
+
 // Reads a whole regular file (refuses directories, devices and files larger than max_bytes).
 rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, size_t *out_len, rs_error *err);
 // Writes via "<path>.tmp.<pid>" then fsync + rename: readers see the old or the new file, never a mix.

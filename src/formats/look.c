@@ -59,7 +59,7 @@ static rs_result parse_stamp(parser *p, bool eraser, char **save)
     for (int k = 0; k < 8; k++) {
         char *tok = strtok_r(NULL, " \t", save);
         if (!tok) return perr(p, "stamp: missing %s", names[k]);
-        if (!rs_text_parse_float(tok, &v[k]) || fabsf(v[k]) > RS_LOOK_MAX_COORD)
+        if (!rs_parse_float(tok, &v[k]) || fabsf(v[k]) > RS_LOOK_MAX_COORD)
             return perr(p, "stamp: %s: '%.64s' is not a finite number within %g", names[k], tok, RS_LOOK_MAX_COORD);
     }
     if (!(v[6] > 0.0f)) return perr(p, "stamp: radius: %g, must be > 0", v[6]);
@@ -73,7 +73,7 @@ static rs_result parse_stamp(parser *p, bool eraser, char **save)
                         (int)lk->cosmetic_count - 1);
     }
     if (strtok_r(NULL, " \t", save)) return perr(p, "stamp: unexpected text after the last field");
-    if (!rs_text_grow((void **)&lk->stamps, &p->stamp_cap, lk->stamp_count + 1, sizeof *lk->stamps))
+    if (!rs_array_grow((void **)&lk->stamps, &p->stamp_cap, lk->stamp_count + 1, sizeof *lk->stamps))
         return rs_fail(p->err, RS_ERR_NOMEM, "line %u: out of memory", p->line);
     lk->stamps[lk->stamp_count++] = (rs_makeup_applied){{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6], v[7],
                                                         (uint16_t)cos, eraser, p->stroke_empty};
@@ -104,7 +104,7 @@ static rs_result parse_line(parser *p, char *line)
     if (strcmp(kw, "face") == 0) {
         if (p->have_face) return perr(p, "face: given twice");
         char *tok = strtok_r(NULL, " \t", &save);
-        if (!tok || strncmp(tok, "height=", 7) != 0 || !rs_text_parse_float(tok + 7, &lk->face_height) ||
+        if (!tok || strncmp(tok, "height=", 7) != 0 || !rs_parse_float(tok + 7, &lk->face_height) ||
             !(lk->face_height > 0.0f) || lk->face_height > RS_LOOK_MAX_COORD)
             return perr(p, "face: expected height=H with H > 0");
         if (strtok_r(NULL, " \t", &save)) return perr(p, "face: unexpected text");
@@ -119,7 +119,7 @@ static rs_result parse_line(parser *p, char *line)
         if (idx >= RS_LOOK_MAX_COSMETICS) return perr(p, "cosmetic: more than %d", RS_LOOK_MAX_COSMETICS);
         char *rest = strtok_r(NULL, "", &save);
         if (!rest) return perr(p, "cosmetic %u: missing definition", idx);
-        if (!rs_text_grow((void **)&lk->cosmetics, &p->cosmetic_cap, lk->cosmetic_count + 1, sizeof *lk->cosmetics))
+        if (!rs_array_grow((void **)&lk->cosmetics, &p->cosmetic_cap, lk->cosmetic_count + 1, sizeof *lk->cosmetics))
             return rs_fail(p->err, RS_ERR_NOMEM, "line %u: out of memory", p->line);
         rs_error inner = {0};
         if (rs_cosmetic_parse(rest, &lk->cosmetics[idx], &inner) != RS_OK) return perr(p, "%s", inner.msg);
@@ -229,20 +229,15 @@ rs_result rs_look_write_memory(const rs_makeup *mk, char **out, size_t *out_len,
 {
     uint32_t n = rs_makeup_log_count(mk), nc = rs_makeup_log_cosmetic_count(mk);
     const rs_makeup_applied *st = rs_makeup_log_stamps(mk);
-    // Upper bound of the text: header + cosmetics + one line per stamp plus stroke lines.
-    size_t cap = 256 + (size_t)nc * 600 + (size_t)n * (9 * 18 + 16) * 2;
-    char *buf = malloc(cap);
+    rs_text_writer w = {0};
     // Only the cosmetics the stamps use (not those of undone or cleared strokes), renumbered in order
     // of first use, so the same layer always writes the same text.
     uint32_t *remap = malloc(((size_t)nc + 1) * sizeof *remap);
-    if (!buf || !remap) {
-        free(buf);
-        free(remap);
+    if (!remap) {
         return rs_fail(err, RS_ERR_NOMEM, "look: writing %u stamps: out of memory", n);
     }
     for (uint32_t i = 0; i < nc; i++) remap[i] = UINT32_MAX;
-    size_t len = 0;
-#define PUT(...) len += (size_t)snprintf(buf + len, cap - len, __VA_ARGS__)
+#define PUT(...) rs_text_printf(&w, __VA_ARGS__)
     PUT("rouge-look %d\n# %u stamps in model space; docs/makeup.md\n", RS_LOOK_VERSION, n);
     PUT("face height=%.9g\n", rs_makeup_cloud(mk)->hdr.face_height);
     uint32_t used = 0;
@@ -264,8 +259,12 @@ rs_result rs_look_write_memory(const rs_makeup *mk, char **out, size_t *out_len,
     if (n) PUT("end\n");
 #undef PUT
     free(remap);
-    *out = buf;
-    *out_len = len;
+    if (w.failed) {
+        free(w.p);
+        return rs_fail(err, RS_ERR_NOMEM, "look: writing %u stamps: out of memory", n);
+    }
+    *out = w.p;
+    *out_len = w.len;
     return RS_OK;
 }
 

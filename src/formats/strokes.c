@@ -96,7 +96,7 @@ rs_result rs_strokes_begin(rs_strokes *doc, const rs_strokes_view *view, const r
     if (doc->open) rs_strokes_end(doc);
     if (doc->count >= RS_STROKES_MAX_STROKES)
         return rs_fail(err, RS_ERR_LIMIT, "strokes: more than %d strokes", RS_STROKES_MAX_STROKES);
-    if (!rs_text_grow((void **)&doc->strokes, &doc->stroke_cap, doc->count + 1, sizeof *doc->strokes))
+    if (!rs_array_grow((void **)&doc->strokes, &doc->stroke_cap, doc->count + 1, sizeof *doc->strokes))
         return rs_fail(err, RS_ERR_NOMEM, "strokes: out of memory");
     doc->strokes[doc->count++] = (rs_strokes_stroke){*view, *brush, *cosmetic, doc->sample_count, 0};
     doc->open = true;
@@ -111,7 +111,7 @@ rs_result rs_strokes_add_sample(rs_strokes *doc, const rs_strokes_sample *sample
     if (r != RS_OK) return r;
     if (doc->sample_count >= RS_STROKES_MAX_SAMPLES)
         return rs_fail(err, RS_ERR_LIMIT, "sample: more than %u samples in the file", RS_STROKES_MAX_SAMPLES);
-    if (!rs_text_grow((void **)&doc->samples, &doc->sample_cap, doc->sample_count + 1, sizeof *doc->samples))
+    if (!rs_array_grow((void **)&doc->samples, &doc->sample_cap, doc->sample_count + 1, sizeof *doc->samples))
         return rs_fail(err, RS_ERR_NOMEM, "strokes: out of memory");
     doc->samples[doc->sample_count++] = *sample;
     st->sample_count++;
@@ -198,7 +198,7 @@ static rs_result parse_view(parser *p, char **save)
             ok = c != NULL;
             if (ok) {
                 *c = '\0';
-                ok = rs_text_parse_float(val, &v.pan[0]) && rs_text_parse_float(c + 1, &v.pan[1]);
+                ok = rs_parse_float(val, &v.pan[0]) && rs_parse_float(c + 1, &v.pan[1]);
             }
         } else if (k == 4) {
             char *x = strchr(val, 'x');
@@ -210,7 +210,7 @@ static rs_result parse_view(parser *p, char **save)
             }
         } else {
             float *f[] = {&v.yaw_deg, &v.pitch_deg, &v.zoom, &v.fov_deg};
-            ok = rs_text_parse_float(val, f[k]);
+            ok = rs_parse_float(val, f[k]);
         }
         if (!ok) return perr(p, "view: %s: bad value '%.64s'", key, val);
     }
@@ -239,9 +239,9 @@ static rs_result parse_brush(parser *p, char **save)
         bool ok;
         uint32_t flag = 0;
         if (k == 0) {
-            ok = rs_text_parse_float(val, &b.size_rel);
+            ok = rs_parse_float(val, &b.size_rel);
         } else if (k == 1) {
-            ok = rs_text_parse_float(val, &b.opacity);
+            ok = rs_parse_float(val, &b.opacity);
         } else if (k == 2) {
             int m = key_index(val, pressure_names, RS_MAKEUP_PRESSURE_COUNT);
             ok = m >= 0;
@@ -268,7 +268,7 @@ static rs_result parse_sample(parser *p, char **save)
     for (int k = 0; k < 4; k++) {
         char *tok = strtok_r(NULL, " \t", save);
         if (!tok) return perr(p, "sample: needs 4 numbers (t x y pressure), got %d", k);
-        if (!rs_text_parse_float(tok, &v[k])) return perr(p, "sample: value %d: '%.64s' is not a finite number", k + 1, tok);
+        if (!rs_parse_float(tok, &v[k])) return perr(p, "sample: value %d: '%.64s' is not a finite number", k + 1, tok);
     }
     if (strtok_r(NULL, " \t", save)) return perr(p, "sample: more than 4 numbers");
     rs_strokes_sample s = {v[0], v[1], v[2], v[3]};
@@ -363,71 +363,37 @@ rs_result rs_strokes_load(const char *path, rs_strokes **out, rs_error *err)
 
 // --- writing -------------------------------------------------------------------------------------
 
-typedef struct sbuf {
-    char *p;
-    size_t len, cap;
-    bool failed;
-} sbuf;
-
-static void sb_printf(sbuf *b, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static void sb_printf(sbuf *b, const char *fmt, ...)
-{
-    if (b->failed) return;
-    for (;;) {
-        va_list ap;
-        va_start(ap, fmt);
-        int n = vsnprintf(b->p ? b->p + b->len : NULL, b->p ? b->cap - b->len : 0, fmt, ap);
-        va_end(ap);
-        if (n < 0) {
-            b->failed = true;
-            return;
-        }
-        if (b->p && (size_t)n < b->cap - b->len) {
-            b->len += (size_t)n;
-            return;
-        }
-        size_t cap = RS_MAX(b->cap * 2, b->len + (size_t)n + 256);
-        char *q = realloc(b->p, cap);
-        if (!q) {
-            b->failed = true;
-            return;
-        }
-        b->p = q;
-        b->cap = cap;
-    }
-}
-
 rs_result rs_strokes_write_memory(const rs_strokes *doc, char **out, size_t *out_len, rs_error *err)
 {
-    sbuf b = {0};
-    sb_printf(&b, "rouge-strokes %d\n", RS_STROKES_VERSION);
+    rs_text_writer b = {0};
+    rs_text_printf(&b, "rouge-strokes %d\n", RS_STROKES_VERSION);
     const rs_strokes_stroke *prev = NULL;
     for (uint32_t i = 0; i < doc->count; i++) {
         const rs_strokes_stroke *s = &doc->strokes[i];
         const rs_strokes_view *v = &s->view;
         const rs_strokes_brush *br = &s->brush;
         if (!prev || memcmp(v, &prev->view, sizeof *v) != 0) {
-            sb_printf(&b, "view yaw=%.9g pitch=%.9g zoom=%.9g fov=%.9g size=%ux%u", v->yaw_deg, v->pitch_deg,
+            rs_text_printf(&b, "view yaw=%.9g pitch=%.9g zoom=%.9g fov=%.9g size=%ux%u", v->yaw_deg, v->pitch_deg,
                       v->zoom, v->fov_deg, v->width_px, v->height_px);
-            if (v->pan[0] != 0 || v->pan[1] != 0) sb_printf(&b, " pan=%.9g,%.9g", v->pan[0], v->pan[1]);
-            sb_printf(&b, "\n");
+            if (v->pan[0] != 0 || v->pan[1] != 0) rs_text_printf(&b, " pan=%.9g,%.9g", v->pan[0], v->pan[1]);
+            rs_text_printf(&b, "\n");
         }
         if (!prev || br->size_rel != prev->brush.size_rel || br->opacity != prev->brush.opacity ||
             br->pressure != prev->brush.pressure || br->mirror != prev->brush.mirror ||
             br->eraser != prev->brush.eraser)
-            sb_printf(&b, "brush size=%.9g opacity=%.9g pressure=%s mirror=%d eraser=%d\n", br->size_rel, br->opacity,
+            rs_text_printf(&b, "brush size=%.9g opacity=%.9g pressure=%s mirror=%d eraser=%d\n", br->size_rel, br->opacity,
                       rs_strokes_pressure_name(br->pressure), br->mirror, br->eraser);
         if (!prev || !rs_cosmetic_equal(&s->cosmetic, &prev->cosmetic)) {
             char c[512];
             rs_cosmetic_format(&s->cosmetic, c, sizeof c);
-            sb_printf(&b, "cosmetic %s\n", c);
+            rs_text_printf(&b, "cosmetic %s\n", c);
         }
-        sb_printf(&b, "stroke\n");
+        rs_text_printf(&b, "stroke\n");
         for (uint32_t k = 0; k < s->sample_count; k++) {
             const rs_strokes_sample *sm = &doc->samples[s->first_sample + k];
-            sb_printf(&b, "s %.9g %.9g %.9g %.9g\n", sm->t_s, sm->x_px, sm->y_px, sm->pressure);
+            rs_text_printf(&b, "s %.9g %.9g %.9g %.9g\n", sm->t_s, sm->x_px, sm->y_px, sm->pressure);
         }
-        sb_printf(&b, "end\n");
+        rs_text_printf(&b, "end\n");
         prev = s;
     }
     if (b.failed) {

@@ -3,6 +3,8 @@
 #include "formats/textfile.h"
 
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -47,15 +49,6 @@ rs_result rs_text_check_header(char *line, const char *magic, uint32_t version, 
     return RS_OK;
 }
 
-bool rs_text_parse_float(const char *s, float *out)
-{
-    char *end;
-    float v = strtof(s, &end);
-    if (end == s || *end != '\0' || !isfinite(v)) return false;
-    *out = v;
-    return true;
-}
-
 bool rs_text_parse_uint(const char *s, uint32_t max, uint32_t *out)
 {
     if (*s < '0' || *s > '9') return false;
@@ -69,16 +62,30 @@ bool rs_text_parse_uint(const char *s, uint32_t max, uint32_t *out)
     return true;
 }
 
-bool rs_text_grow(void **ptr, uint32_t *cap, uint32_t need, size_t elem)
+
+void rs_text_printf(rs_text_writer *w, const char *fmt, ...)
 {
-    if (need <= *cap) return true;
-    uint64_t c = RS_MAX((uint64_t)*cap * 2, 64u);
-    while (c < need) c *= 2;
-    size_t bytes;
-    if (c > UINT32_MAX || !rs_size_mul((size_t)c, elem, &bytes)) return false;
-    void *q = realloc(*ptr, bytes);
-    if (!q) return false;
-    *ptr = q;
-    *cap = (uint32_t)c;
-    return true;
+    if (w->failed) return;
+    for (;;) {
+        va_list ap;
+        va_start(ap, fmt);
+        int n = vsnprintf(w->p ? w->p + w->len : NULL, w->p ? w->cap - w->len : 0, fmt, ap);
+        va_end(ap);
+        if (n < 0) {
+            w->failed = true;
+            return;
+        }
+        if (w->p && (size_t)n < w->cap - w->len) {
+            w->len += (size_t)n;
+            return;
+        }
+        size_t cap = RS_MAX(w->cap * 2, w->len + (size_t)n + 256);
+        char *q = realloc(w->p, cap);
+        if (!q) {
+            w->failed = true;
+            return;
+        }
+        w->p = q;
+        w->cap = cap;
+    }
 }

@@ -3,7 +3,8 @@
 //
 // Does: walk a buffer line by line (CRLF accepted, blank and '#' lines skipped, over-long lines and NUL
 // bytes refused with "line N: ..."), check a "<magic> <version>" first line, parse whole finite
-// numbers, grow arrays with checked sizes.
+// numbers (rs_parse_number underneath; arrays grow with rs_array_grow); append formatted text to a
+// growing buffer.
 // Does not: know any format's keywords.
 //
 //   rs_text_reader t = {.data = data, .len = len};
@@ -27,10 +28,16 @@ bool rs_text_next_line(rs_text_reader *t, char *buf, size_t cap, char **line, rs
 // Checks that `line` is exactly "<magic> <version>"; `what` names the format in the error.
 rs_result rs_text_check_header(char *line, const char *magic, uint32_t version, const char *what, uint32_t lineno,
                                rs_error *err);
-// Whole-token parses: false on trailing garbage, non-finite values or values over max.
-bool rs_text_parse_float(const char *s, float *out);
+// Whole-token unsigned integer: false on anything but digits, or a value over max (floats: rs_parse_float).
 bool rs_text_parse_uint(const char *s, uint32_t max, uint32_t *out);
-// Grows *ptr to hold at least `need` elements (capacity doubles, sizes checked).
-bool rs_text_grow(void **ptr, uint32_t *cap, uint32_t need, size_t elem);
+
+// A growing text buffer for writers: rs_text_printf appends (the buffer doubles as needed); on a failed
+// allocation `failed` is set and later appends do nothing, so a writer checks once at the end.
+typedef struct rs_text_writer {
+    char *p;  // NUL-terminated text (malloc'd; the caller frees or hands it on)
+    size_t len, cap;
+    bool failed;
+} rs_text_writer;
+void rs_text_printf(rs_text_writer *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 #endif

@@ -13,6 +13,7 @@
 #define _POSIX_C_SOURCE 200809L  // strtok_r
 #include "makeup/cosmetics.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <stdio.h>
@@ -223,32 +224,12 @@ int rs_cosmetic_format(const rs_cosmetic *c, char *buf, size_t cap)
                     c->size_rel, c->opacity, finish);
 }
 
-static bool parse_f(const char *s, float *out)
-{
-    char *end;
-    float v = strtof(s, &end);
-    if (end == s || *end != '\0' || !isfinite(v)) return false;
-    *out = v;
-    return true;
-}
-
 // "a,b,c" into three floats.
-static bool parse_f3(char *s, float out[3])
+static bool parse_f3(const char *s, float out[3])
 {
-    char *parts[3];
-    for (int k = 0; k < 3; k++) {
-        parts[k] = s;
-        char *comma = strchr(s, ',');
-        if (k < 2) {
-            if (!comma) return false;
-            *comma = '\0';
-            s = comma + 1;
-        } else if (comma) {
-            return false;
-        }
-    }
-    for (int k = 0; k < 3; k++)
-        if (!parse_f(parts[k], &out[k])) return false;
+    double v[3];
+    if (!rs_parse_list(s, ',', 3, -FLT_MAX, FLT_MAX, v)) return false;
+    for (int k = 0; k < 3; k++) out[k] = (float)v[k];
     return true;
 }
 
@@ -314,7 +295,7 @@ rs_result rs_cosmetic_parse(const char *text, rs_cosmetic *out, rs_error *err)
             while (k < RS_COUNT_OF(fields) && strcmp(key, fields[k].key) != 0) k++;
             if (k == RS_COUNT_OF(fields))
                 return rs_fail(err, RS_ERR_FORMAT, "cosmetic custom: unknown key '%.32s'", key);
-            ok = parse_f(val, &f);
+            ok = rs_parse_float(val, &f);
             if (ok) *fields[k].field = f;
             if (ok && fields[k].seen) *fields[k].seen = true;
         }

@@ -747,27 +747,12 @@ static bool stamp_cell(void *user, const grid_cell *gc)
     return true;
 }
 
-static bool grow(void **p, uint32_t *cap, uint32_t need, size_t elem)
-{
-    if (need <= *cap) return true;
-    uint64_t c = RS_MAX((uint64_t)*cap * 2, 64u);
-    while (c < need) c *= 2;
-    c = RS_MIN(c, (uint64_t)UINT32_MAX);
-    size_t bytes;
-    if (!rs_size_mul((size_t)c, elem, &bytes)) return false;
-    void *q = realloc(*p, bytes);
-    if (!q) return false;
-    *p = q;
-    *cap = (uint32_t)c;
-    return true;
-}
-
 static int log_cosmetic(rs_makeup *mk, const rs_cosmetic *c)
 {
     for (uint32_t i = 0; i < mk->cosmetic_count; i++)
         if (rs_cosmetic_equal(&mk->cosmetics[i], c)) return (int)i;
     if (mk->cosmetic_count >= UINT16_MAX) return -1;
-    if (!grow((void **)&mk->cosmetics, &mk->cosmetic_cap, mk->cosmetic_count + 1, sizeof *mk->cosmetics))
+    if (!rs_array_grow((void **)&mk->cosmetics, &mk->cosmetic_cap, mk->cosmetic_count + 1, sizeof *mk->cosmetics))
         return -1;
     mk->cosmetics[mk->cosmetic_count] = *c;
     return (int)mk->cosmetic_count++;
@@ -839,11 +824,11 @@ rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeu
     if (mirror_idx != UINT32_MAX) need += sum_cell_counts(mk, mk->cloud->pos[mirror_idx], d->radius);
     int cos_index = d->eraser ? 0 : log_cosmetic(mk, d->cosmetic);
     bool ok = cos_index >= 0 && mk->stamp_count + 2 <= LOG_STAMPS_MAX &&
-              grow((void **)&mk->stamps, &mk->stamp_cap, mk->stamp_count + 2, sizeof *mk->stamps) &&
-              grow((void **)&mk->slots, &mk->slot_cap, (uint32_t)RS_MIN((uint64_t)mk->slot_count + need,
+              rs_array_grow((void **)&mk->stamps, &mk->stamp_cap, mk->stamp_count + 2, sizeof *mk->stamps) &&
+              rs_array_grow((void **)&mk->slots, &mk->slot_cap, (uint32_t)RS_MIN((uint64_t)mk->slot_count + need,
                                                                        (uint64_t)mk->n + 1), sizeof *mk->slots) &&
               (mk->stroke_reserved ||
-               grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes));
+               rs_array_grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes));
     if (!ok) {
         if (implicit) mk->in_stroke = false;
         return rs_fail(err, mk->stamp_count + 2 > LOG_STAMPS_MAX ? RS_ERR_LIMIT : RS_ERR_NOMEM,
@@ -898,7 +883,7 @@ static void forget_all_history(rs_makeup *mk)
 // Pushes a finished stroke's deltas (taking ownership) and evicts the oldest beyond the budget.
 static rs_result push_history(rs_makeup *mk, delta *d, uint32_t n, rs_error *err)
 {
-    if (!grow((void **)&mk->hist, &mk->hist_cap, mk->hist_count + 1, sizeof *mk->hist)) {
+    if (!rs_array_grow((void **)&mk->hist, &mk->hist_cap, mk->hist_count + 1, sizeof *mk->hist)) {
         free(d);
         forget_all_history(mk);
         return rs_fail(err, RS_ERR_NOMEM, "makeup: undo history: out of memory (history dropped)");
@@ -1034,7 +1019,7 @@ rs_result rs_makeup_clear(rs_makeup *mk, rs_makeup_range *dirty, rs_error *err)
         if (mk->touch[i] || memcmp(&mk->rec[i], &zero, sizeof zero) != 0) changed++;
     if (changed == 0) return RS_OK;
     delta *d = rs_alloc_array(changed, sizeof *d);
-    if (!d || !grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes)) {
+    if (!d || !rs_array_grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes)) {
         free(d);
         return rs_fail(err, RS_ERR_NOMEM, "makeup: clear: out of memory");
     }

@@ -61,8 +61,6 @@ static const uint32_t crc_table[256] = {
     0xb40bbe37u, 0xc30c8ea1u, 0x5a05df1bu, 0x2d02ef8du,
 };
 
-static uint32_t rd_u32(const uint8_t *p) { return rsf_rd_u32(p); }
-
 // Large buffers go 8 bytes per step ("slicing-by-8", Kounavis & Berry 2005): t[k][b] is the CRC of byte b
 // followed by k zero bytes. The tables take ~2 us to build, so they live on the stack, not in a global.
 static uint32_t crc32_sliced(uint32_t crc, const uint8_t *p, size_t len)
@@ -72,7 +70,7 @@ static uint32_t crc32_sliced(uint32_t crc, const uint8_t *p, size_t len)
     for (int k = 1; k < 8; k++)
         for (int b = 0; b < 256; b++) t[k][b] = (t[k - 1][b] >> 8) ^ crc_table[t[k - 1][b] & 0xffu];
     for (; len >= 8; len -= 8, p += 8) {
-        uint32_t lo = crc ^ rd_u32(p), hi = rd_u32(p + 4);
+        uint32_t lo = crc ^ rs_le32_get(p), hi = rs_le32_get(p + 4);
         crc = t[7][lo & 0xffu] ^ t[6][(lo >> 8) & 0xffu] ^ t[5][(lo >> 16) & 0xffu] ^ t[4][lo >> 24] ^
               t[3][hi & 0xffu] ^ t[2][(hi >> 8) & 0xffu] ^ t[1][(hi >> 16) & 0xffu] ^ t[0][hi >> 24];
     }
@@ -89,33 +87,16 @@ uint32_t rs_crc32(uint32_t crc, const void *data, size_t len)
     return ~crc;
 }
 
-// ---- little-endian fields, independent of the host ----
-
-static float rd_f32(const uint8_t *p)
-{
-    uint32_t u = rd_u32(p);
-    float f;
-    memcpy(&f, &u, sizeof f);
-    return f;
-}
-
-static void wr_u32(uint8_t *p, uint32_t v) { rsf_wr_u32(p, v); }
-
-static void wr_f32(uint8_t *p, float f)
-{
-    uint32_t u;
-    memcpy(&u, &f, sizeof u);
-    wr_u32(p, u);
-}
+// ---- little-endian fields (core.h), independent of the host ----
 
 static void rd_vec3(const uint8_t *b, size_t off, float v[3])
 {
-    for (int a = 0; a < 3; a++) v[a] = rd_f32(b + off + 4 * (size_t)a);
+    for (int a = 0; a < 3; a++) v[a] = rs_lef32_get(b + off + 4 * (size_t)a);
 }
 
 static void wr_vec3(uint8_t *b, size_t off, const float v[3])
 {
-    for (int a = 0; a < 3; a++) wr_f32(b + off + 4 * (size_t)a, v[a]);
+    for (int a = 0; a < 3; a++) rs_lef32_put(b + off + 4 * (size_t)a, v[a]);
 }
 
 static size_t header_size_for(size_t notes_len) { return rsf_align16(RSF_OFF_NOTES + notes_len); }
@@ -124,25 +105,25 @@ static size_t header_size_for(size_t notes_len) { return rsf_align16(RSF_OFF_NOT
 void rs_rsf_read_fixed_header(const uint8_t *b, rs_splat_header *h)
 {
     memset(h, 0, sizeof *h);
-    h->flags = rd_u32(b + RSF_OFF_FLAGS);
-    h->count = rd_u32(b + RSF_OFF_COUNT);
+    h->flags = rs_le32_get(b + RSF_OFF_FLAGS);
+    h->count = rs_le32_get(b + RSF_OFF_COUNT);
     rd_vec3(b, RSF_OFF_BBOX_MIN, h->bbox_min);
     rd_vec3(b, RSF_OFF_BBOX_MAX, h->bbox_max);
-    h->radius_min = rd_f32(b + RSF_OFF_RADIUS_MIN);
-    h->radius_max = rd_f32(b + RSF_OFF_RADIUS_MAX);
-    h->mm_per_unit = rd_f32(b + RSF_OFF_MM_PER_UNIT);
+    h->radius_min = rs_lef32_get(b + RSF_OFF_RADIUS_MIN);
+    h->radius_max = rs_lef32_get(b + RSF_OFF_RADIUS_MAX);
+    h->mm_per_unit = rs_lef32_get(b + RSF_OFF_MM_PER_UNIT);
     rd_vec3(b, RSF_OFF_CENTRE, h->centre);
     rd_vec3(b, RSF_OFF_FORWARD, h->forward);
     rd_vec3(b, RSF_OFF_UP, h->up);
-    h->face_height = rd_f32(b + RSF_OFF_FACE_HEIGHT);
-    h->lod_count = rd_u32(b + RSF_OFF_LOD_COUNT);
-    for (size_t k = 0; k < RS_SPLAT_MAX_LODS; k++) h->lods[k] = rd_u32(b + RSF_OFF_LODS + 4 * k);
-    h->region_count = rd_u32(b + RSF_OFF_REGION_COUNT);
+    h->face_height = rs_lef32_get(b + RSF_OFF_FACE_HEIGHT);
+    h->lod_count = rs_le32_get(b + RSF_OFF_LOD_COUNT);
+    for (size_t k = 0; k < RS_SPLAT_MAX_LODS; k++) h->lods[k] = rs_le32_get(b + RSF_OFF_LODS + 4 * k);
+    h->region_count = rs_le32_get(b + RSF_OFF_REGION_COUNT);
     for (size_t k = 0; k < RS_SPLAT_MAX_REGIONS; k++) {
         const uint8_t *r = b + RSF_OFF_REGIONS + k * RSF_REGION_SIZE;
         memcpy(h->regions[k].name, r, sizeof h->regions[k].name);
-        h->regions[k].m = rd_f32(r + 16);
-        h->regions[k].rho_s = rd_f32(r + 20);
+        h->regions[k].m = rs_lef32_get(r + 16);
+        h->regions[k].rho_s = rs_lef32_get(r + 20);
     }
 }
 
@@ -151,30 +132,30 @@ void rs_rsf_write_fixed_header(uint8_t *b, const rs_splat_header *h, uint32_t ve
                                size_t header_size)
 {
     memcpy(b + RSF_OFF_MAGIC, rsf_magic, sizeof rsf_magic);
-    wr_u32(b + RSF_OFF_VERSION, version);
-    wr_u32(b + RSF_OFF_HEADER_SIZE, (uint32_t)header_size);
-    wr_u32(b + RSF_OFF_FLAGS, h->flags);
-    wr_u32(b + RSF_OFF_COUNT, h->count);
+    rs_le32_put(b + RSF_OFF_VERSION, version);
+    rs_le32_put(b + RSF_OFF_HEADER_SIZE, (uint32_t)header_size);
+    rs_le32_put(b + RSF_OFF_FLAGS, h->flags);
+    rs_le32_put(b + RSF_OFF_COUNT, h->count);
     wr_vec3(b, RSF_OFF_BBOX_MIN, h->bbox_min);
     wr_vec3(b, RSF_OFF_BBOX_MAX, h->bbox_max);
-    wr_f32(b + RSF_OFF_RADIUS_MIN, h->radius_min);
-    wr_f32(b + RSF_OFF_RADIUS_MAX, h->radius_max);
-    wr_f32(b + RSF_OFF_MM_PER_UNIT, h->mm_per_unit);
+    rs_lef32_put(b + RSF_OFF_RADIUS_MIN, h->radius_min);
+    rs_lef32_put(b + RSF_OFF_RADIUS_MAX, h->radius_max);
+    rs_lef32_put(b + RSF_OFF_MM_PER_UNIT, h->mm_per_unit);
     wr_vec3(b, RSF_OFF_CENTRE, h->centre);
     wr_vec3(b, RSF_OFF_FORWARD, h->forward);
     wr_vec3(b, RSF_OFF_UP, h->up);
-    wr_f32(b + RSF_OFF_FACE_HEIGHT, h->face_height);
-    wr_u32(b + RSF_OFF_LOD_COUNT, h->lod_count);
+    rs_lef32_put(b + RSF_OFF_FACE_HEIGHT, h->face_height);
+    rs_le32_put(b + RSF_OFF_LOD_COUNT, h->lod_count);
     // Unused slots stay 0 (the buffer is zeroed): one canonical byte form per cloud.
-    for (size_t k = 0; k < h->lod_count; k++) wr_u32(b + RSF_OFF_LODS + 4 * k, h->lods[k]);
-    wr_u32(b + RSF_OFF_REGION_COUNT, h->region_count);
+    for (size_t k = 0; k < h->lod_count; k++) rs_le32_put(b + RSF_OFF_LODS + 4 * k, h->lods[k]);
+    rs_le32_put(b + RSF_OFF_REGION_COUNT, h->region_count);
     for (size_t k = 0; k < h->region_count; k++) {
         uint8_t *r = b + RSF_OFF_REGIONS + k * RSF_REGION_SIZE;
         memcpy(r, h->regions[k].name, strnlen(h->regions[k].name, sizeof h->regions[k].name));
-        wr_f32(r + 16, h->regions[k].m);
-        wr_f32(r + 20, h->regions[k].rho_s);
+        rs_lef32_put(r + 16, h->regions[k].m);
+        rs_lef32_put(r + 20, h->regions[k].rho_s);
     }
-    wr_u32(b + RSF_OFF_NOTES_LEN, (uint32_t)notes_len);
+    rs_le32_put(b + RSF_OFF_NOTES_LEN, (uint32_t)notes_len);
     memcpy(b + RSF_OFF_NOTES, h->notes, notes_len);
 }
 
@@ -194,7 +175,7 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
                        b[0], b[1], b[2], b[3]);
     if (len < RSF_OFF_VERSION + 4)
         return rs_fail(err, RS_ERR_FORMAT, "%s: version: file ends inside the header (byte %zu)", name, len);
-    uint32_t version = rd_u32(b + RSF_OFF_VERSION);
+    uint32_t version = rs_le32_get(b + RSF_OFF_VERSION);
     if (version != RSF_VERSION_1)
         return rs_fail(err, RS_ERR_FORMAT,
                        "%s: version: unsupported version %u (this build reads versions 1 and 2) (byte %d)", name,
@@ -204,7 +185,7 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
                        "%s: header: file is %zu bytes, ends inside the %d-byte fixed header (byte %zu)", name, len,
                        RSF_OFF_NOTES, len);
 
-    uint32_t notes_len = rd_u32(b + RSF_OFF_NOTES_LEN);
+    uint32_t notes_len = rs_le32_get(b + RSF_OFF_NOTES_LEN);
     if (notes_len > RS_SPLAT_MAX_NOTES - 1)
         return rs_fail(err, RS_ERR_FORMAT, "%s: notes_len: %u bytes, at most %d allowed (byte %d)", name, notes_len,
                        RS_SPLAT_MAX_NOTES - 1, RSF_OFF_NOTES_LEN);
@@ -212,13 +193,13 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
         return rs_fail(err, RS_ERR_FORMAT,
                        "%s: notes_len: %u bytes of notes run past the end of the file (%zu bytes) (byte %d)", name,
                        notes_len, len, RSF_OFF_NOTES_LEN);
-    uint32_t header_size = rd_u32(b + RSF_OFF_HEADER_SIZE);
+    uint32_t header_size = rs_le32_get(b + RSF_OFF_HEADER_SIZE);
     size_t expected = header_size_for(notes_len);
     if (header_size != expected)
         return rs_fail(err, RS_ERR_FORMAT, "%s: header_size: %u, expected %zu for %u bytes of notes (byte %d)", name,
                        header_size, expected, notes_len, RSF_OFF_HEADER_SIZE);
 
-    uint32_t count = rd_u32(b + RSF_OFF_COUNT);
+    uint32_t count = rs_le32_get(b + RSF_OFF_COUNT);
     if (count == 0) return rs_fail(err, RS_ERR_FORMAT, "%s: count: 0 splats (byte %d)", name, RSF_OFF_COUNT);
     if (count > RS_SPLAT_MAX_COUNT)
         return rs_fail(err, RS_ERR_LIMIT, "%s: count: %u splats, more than the %u allowed (byte %d)", name, count,
@@ -236,7 +217,7 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
                        total);
 
     size_t crc_off = total - RSF_CRC_SIZE;
-    uint32_t stored = rd_u32(b + crc_off), computed = rs_crc32(0, b, crc_off);
+    uint32_t stored = rs_le32_get(b + crc_off), computed = rs_crc32(0, b, crc_off);
     if (stored != computed)
         return rs_fail(err, RS_ERR_FORMAT, "%s: crc: stored 0x%08x, computed 0x%08x: the file is damaged (byte %zu)",
                        name, stored, computed, crc_off);
@@ -272,7 +253,7 @@ rs_result rs_rsf1_load(const uint8_t *b, size_t len, const char *name, rs_splat_
     free(h);
     const uint8_t *p = b + payload_off;
     for (size_t i = 0; i < c->hdr.count; i++, p += RSF_RECORD_SIZE)
-        for (size_t k = 0; k < 4; k++) c->packed[i].w[k] = rd_u32(p + 4 * k);
+        for (size_t k = 0; k < 4; k++) c->packed[i].w[k] = rs_le32_get(p + 4 * k);
     r = rs_splat_decode_all(c, name, true, payload_off, err);
     if (r != RS_OK) {
         rs_splat_destroy(c);
@@ -287,7 +268,7 @@ rs_result rs_rsf1_load(const uint8_t *b, size_t len, const char *name, rs_splat_
 static rs_result load_bytes(const uint8_t *b, size_t len, const char *name, rs_splat_cloud **out, rs_error *err)
 {
     if (len >= RSF_OFF_VERSION + 4 && memcmp(b, rsf_magic, sizeof rsf_magic) == 0 &&
-        rd_u32(b + RSF_OFF_VERSION) == RSF_VERSION_2)
+        rs_le32_get(b + RSF_OFF_VERSION) == RSF_VERSION_2)
         return rs_rsf2_load(b, len, name, out, err);
     return rs_rsf1_load(b, len, name, out, err);
 }
@@ -341,8 +322,8 @@ static rs_result encode_v1(const rs_splat_cloud *c, const char *name, void **out
     rs_rsf_write_fixed_header(b, h, RSF_VERSION_1, notes_len, header_size);
     uint8_t *p = b + header_size;
     for (size_t i = 0; i < h->count; i++, p += RSF_RECORD_SIZE)
-        for (size_t k = 0; k < 4; k++) wr_u32(p + 4 * k, c->packed[i].w[k]);
-    wr_u32(p, rs_crc32(0, b, total - RSF_CRC_SIZE));
+        for (size_t k = 0; k < 4; k++) rs_le32_put(p + 4 * k, c->packed[i].w[k]);
+    rs_le32_put(p, rs_crc32(0, b, total - RSF_CRC_SIZE));
     *out_data = b;
     *out_len = total;
     return RS_OK;

@@ -159,12 +159,12 @@ static rs_result encode_chunk(const rs_splat_packed *rec, rsf2_chunk *ch, int le
             memcpy(dst + total, plane, n);
             r = n;
         }
-        rsf_wr_u32(dst + 4 * (size_t)b, (uint32_t)r);
+        rs_le32_put(dst + 4 * (size_t)b, (uint32_t)r);
         total += r;
     }
     if (total >= raw || (uint64_t)total * RSF2_MAX_EXPANSION < raw) {
         for (uint32_t i = 0; i < n; i++)
-            for (int k = 0; k < 4; k++) rsf_wr_u32(dst + 16 * (size_t)i + 4 * (size_t)k, rec[i].w[k]);
+            for (int k = 0; k < 4; k++) rs_le32_put(dst + 16 * (size_t)i + 4 * (size_t)k, rec[i].w[k]);
         ch->codec = RSF2_CODEC_STORED;
         ch->bytes = (uint32_t)raw;
     } else {
@@ -215,15 +215,15 @@ rs_result rs_rsf2_encode(const rs_splat_cloud *c, const rs_splat_save_desc *d, c
     if (r != RS_OK) goto out;
     rs_rsf_write_fixed_header(b, h, RSF_VERSION_2, notes_len, header_size);
     uint8_t *t = b + rsf_align16(RSF_OFF_NOTES + notes_len);
-    rsf_wr_u32(t, nchunks);
+    rs_le32_put(t, nchunks);
     for (uint32_t k = 0; k < nchunks; k++) {
         uint8_t *e = t + RSF2_TABLE_HEAD + (size_t)k * RSF2_ENTRY_SIZE;
-        rsf_wr_u32(e, chunks[k].splats);
-        rsf_wr_u32(e + 4, chunks[k].bytes);
-        rsf_wr_u32(e + 8, chunks[k].crc);
-        rsf_wr_u32(e + 12, chunks[k].codec);
+        rs_le32_put(e, chunks[k].splats);
+        rs_le32_put(e + 4, chunks[k].bytes);
+        rs_le32_put(e + 8, chunks[k].crc);
+        rs_le32_put(e + 12, chunks[k].codec);
     }
-    rsf_wr_u32(b + header_size - RSF_CRC_SIZE, rs_crc32(0, b, header_size - RSF_CRC_SIZE));
+    rs_le32_put(b + header_size - RSF_CRC_SIZE, rs_crc32(0, b, header_size - RSF_CRC_SIZE));
     uint8_t *shrunk = realloc(b, at);
     *out_data = shrunk ? shrunk : b;
     *out_len = at;
@@ -351,7 +351,7 @@ static bool reserve(rs_splat_loader *l, uint32_t n)
 static rs_result start(rs_splat_loader *l, const uint8_t *b, rs_error *err)
 {
     static const uint8_t magic[4] = {'R', 'S', 'F', 0};
-    uint32_t version = rsf_rd_u32(b + RSF_OFF_VERSION);
+    uint32_t version = rs_le32_get(b + RSF_OFF_VERSION);
     if (memcmp(b, magic, 4) != 0 || (version != RSF_VERSION_1 && version != RSF_VERSION_2)) {
         rs_splat_cloud *c = NULL;
         rs_result r = rs_rsf1_load(b, 12, l->name, &c, err);
@@ -362,7 +362,7 @@ static rs_result start(rs_splat_loader *l, const uint8_t *b, rs_error *err)
         l->st = LD_V1;
         return RS_OK;
     }
-    uint32_t hs = rsf_rd_u32(b + RSF_OFF_HEADER_SIZE);
+    uint32_t hs = rs_le32_get(b + RSF_OFF_HEADER_SIZE);
     size_t min = header_size_v2(0, 1);
     if (hs < min || hs > RSF2_MAX_HEADER || hs % RSF_PAYLOAD_ALIGN != 0)
         return ld_fail(l, err, RS_ERR_FORMAT,
@@ -397,8 +397,8 @@ static rs_result parse_table(rs_splat_loader *l, const uint8_t *b, size_t table,
     for (uint32_t k = 0; k < l->chunk_count; k++) {
         size_t e = table + RSF2_TABLE_HEAD + (size_t)k * RSF2_ENTRY_SIZE;
         rsf2_chunk *ch = &l->chunks[k];
-        *ch = (rsf2_chunk){(uint32_t)RS_MIN(first, UINT32_MAX), rsf_rd_u32(b + e), rsf_rd_u32(b + e + 4),
-                           rsf_rd_u32(b + e + 8), rsf_rd_u32(b + e + 12), off};
+        *ch = (rsf2_chunk){(uint32_t)RS_MIN(first, UINT32_MAX), rs_le32_get(b + e), rs_le32_get(b + e + 4),
+                           rs_le32_get(b + e + 8), rs_le32_get(b + e + 12), off};
         if (ch->splats == 0 || ch->splats > RSF2_MAX_CHUNK_SPLATS)
             return ld_fail(l, err, RS_ERR_FORMAT, "%s: chunks[%u].splats: %u, must be 1..%u (byte %zu)", l->name, k,
                            ch->splats, RSF2_MAX_CHUNK_SPLATS, e);
@@ -447,11 +447,11 @@ static rs_result parse_table(rs_splat_loader *l, const uint8_t *b, size_t table,
 static rs_result parse_header(rs_splat_loader *l, const uint8_t *b, rs_error *err)
 {
     size_t hs = l->header_size, crc_off = hs - RSF_CRC_SIZE;
-    uint32_t stored = rsf_rd_u32(b + crc_off), computed = rs_crc32(0, b, crc_off);
+    uint32_t stored = rs_le32_get(b + crc_off), computed = rs_crc32(0, b, crc_off);
     if (stored != computed)
         return ld_fail(l, err, RS_ERR_FORMAT, "%s: header crc: stored 0x%08x, computed 0x%08x: the file is damaged (byte %zu)",
                        l->name, stored, computed, crc_off);
-    uint32_t notes_len = rsf_rd_u32(b + RSF_OFF_NOTES_LEN);
+    uint32_t notes_len = rs_le32_get(b + RSF_OFF_NOTES_LEN);
     if (notes_len > RS_SPLAT_MAX_NOTES - 1)
         return ld_fail(l, err, RS_ERR_FORMAT, "%s: notes_len: %u bytes, at most %d allowed (byte %d)", l->name, notes_len,
                        RS_SPLAT_MAX_NOTES - 1, RSF_OFF_NOTES_LEN);
@@ -459,7 +459,7 @@ static rs_result parse_header(rs_splat_loader *l, const uint8_t *b, rs_error *er
     if (table + RSF2_TABLE_HEAD > crc_off)
         return ld_fail(l, err, RS_ERR_FORMAT, "%s: notes_len: %u bytes of notes leave no room for the chunk table in a "
                        "%zu-byte header (byte %d)", l->name, notes_len, hs, RSF_OFF_NOTES_LEN);
-    uint32_t nchunks = rsf_rd_u32(b + table);
+    uint32_t nchunks = rs_le32_get(b + table);
     if (nchunks == 0 || nchunks > RSF2_MAX_CHUNKS)
         return ld_fail(l, err, RS_ERR_FORMAT, "%s: chunk_count: %u, must be 1..%u (byte %zu)", l->name, nchunks,
                        RSF2_MAX_CHUNKS, table);
@@ -478,7 +478,7 @@ static rs_result parse_header(rs_splat_loader *l, const uint8_t *b, rs_error *er
         if (i < crc_off && b[i] != 0) return ld_fail(l, err, RS_ERR_FORMAT, "%s: padding: must be 0 (byte %zu)", l->name, i);
         if (i >= crc_off) break;
     }
-    if (rsf_rd_u32(b + table + 4) != 0)
+    if (rs_le32_get(b + table + 4) != 0)
         return ld_fail(l, err, RS_ERR_FORMAT, "%s: chunk table: reserved word must be 0 (byte %zu)", l->name, table + 4);
 
     l->c = calloc(1, sizeof *l->c);
@@ -527,7 +527,7 @@ static rs_result decode_planes(rs_splat_loader *l, const rsf2_chunk *ch, uint32_
     if (!l->dctx && !(l->dctx = ZSTD_createDCtx())) return ld_fail(l, err, RS_ERR_NOMEM, "%s: out of memory", l->name);
     uint64_t at = RSF2_PLANE_TABLE;
     for (int p = 0; p < RSF2_PLANES; p++) {
-        uint32_t size = rsf_rd_u32(b + 4 * (size_t)p);
+        uint32_t size = rs_le32_get(b + 4 * (size_t)p);
         uint64_t where = ch->off + at;
         if (size > ch->bytes - at)
             return ld_fail(l, err, RS_ERR_FORMAT, "%s: chunk %u: plane %d: %u bytes run past the chunk's end (byte %llu)",
@@ -574,7 +574,7 @@ static rs_result decode_chunk(rs_splat_loader *l, const uint8_t *b, rs_error *er
     if (stored) {
         rs_splat_packed *rec = l->c->packed + ch->first;
         for (uint32_t i = 0; i < ch->splats; i++)
-            for (int w = 0; w < 4; w++) rec[i].w[w] = rsf_rd_u32(b + 16 * (size_t)i + 4 * (size_t)w);
+            for (int w = 0; w < 4; w++) rec[i].w[w] = rs_le32_get(b + 16 * (size_t)i + 4 * (size_t)w);
         r = check_block(&x, 0, ch->splats);
     } else {
         r = decode_planes(l, ch, k, b, check_block, &x, err);
@@ -608,8 +608,8 @@ rs_result rs_splat_loader_feed(rs_splat_loader *l, const void *data, size_t len,
             // shorter file) and the largest file it accepts.
             uint64_t total = RSF_MAX_FILE_BYTES_V1;
             if (l->have >= RSF_OFF_COUNT + 4)
-                total = RS_MIN(total, (uint64_t)rsf_rd_u32(l->buf + RSF_OFF_HEADER_SIZE) +
-                                          (uint64_t)rsf_rd_u32(l->buf + RSF_OFF_COUNT) * RSF_RECORD_SIZE + RSF_CRC_SIZE);
+                total = RS_MIN(total, (uint64_t)rs_le32_get(l->buf + RSF_OFF_HEADER_SIZE) +
+                                          (uint64_t)rs_le32_get(l->buf + RSF_OFF_COUNT) * RSF_RECORD_SIZE + RSF_CRC_SIZE);
             if (len > total - RS_MIN(total, (uint64_t)l->have))
                 return ld_fail(l, err, RS_ERR_FORMAT, "%s: file: more bytes than the %llu its header announces (byte %llu)",
                                l->name, (unsigned long long)total, (unsigned long long)total);
@@ -671,8 +671,8 @@ uint32_t rs_splat_loader_ready(const rs_splat_loader *l)
 static bool v1_complete(const rs_splat_loader *l)
 {
     if (l->have < RSF_OFF_COUNT + 4) return false;
-    uint64_t total = (uint64_t)rsf_rd_u32(l->buf + RSF_OFF_HEADER_SIZE) +
-                     (uint64_t)rsf_rd_u32(l->buf + RSF_OFF_COUNT) * RSF_RECORD_SIZE + RSF_CRC_SIZE;
+    uint64_t total = (uint64_t)rs_le32_get(l->buf + RSF_OFF_HEADER_SIZE) +
+                     (uint64_t)rs_le32_get(l->buf + RSF_OFF_COUNT) * RSF_RECORD_SIZE + RSF_CRC_SIZE;
     return l->have >= total;
 }
 
@@ -733,7 +733,7 @@ rs_result rs_splat_loader_finish(rs_splat_loader *l, rs_splat_cloud **out, rs_er
     }
     case LD_START:
         if (l->have >= RSF_OFF_VERSION + 4 && memcmp(l->buf, "RSF", 4) == 0 &&
-            rsf_rd_u32(l->buf + RSF_OFF_VERSION) == RSF_VERSION_2)
+            rs_le32_get(l->buf + RSF_OFF_VERSION) == RSF_VERSION_2)
             return ld_fail(l, err, RS_ERR_FORMAT, "%s: header_size: file ends inside the header (byte %zu)", l->name,
                            l->have);
         // Fewer than 12 bytes: what the v1 loader says about a file this short (magic, version, header).
@@ -802,7 +802,7 @@ rs_result rs_rsf2_chunk_decode(const uint8_t *b, size_t len, uint32_t codec, uin
     rs_result r = RS_OK;
     if (codec == RSF2_CODEC_STORED && len == (size_t)n * RSF_RECORD_SIZE) {
         for (uint32_t i = 0; i < n; i++)
-            for (int w = 0; w < 4; w++) out[i].w[w] = rsf_rd_u32(b + 16 * (size_t)i + 4 * (size_t)w);
+            for (int w = 0; w < 4; w++) out[i].w[w] = rs_le32_get(b + 16 * (size_t)i + 4 * (size_t)w);
     } else if (codec == RSF2_CODEC_ZSTD && len >= RSF2_PLANE_TABLE && len <= UINT32_MAX) {
         r = decode_planes(&l, &ch, 0, b, no_check, NULL, err);
     } else {

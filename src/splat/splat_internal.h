@@ -63,20 +63,6 @@ enum {
     ((size_t)RSF_OFF_NOTES + RS_SPLAT_MAX_NOTES + RSF_PAYLOAD_ALIGN + (size_t)RS_SPLAT_MAX_COUNT * RSF_RECORD_SIZE + \
      RSF_CRC_SIZE)
 
-// ---- little-endian fields, independent of the host ----
-
-static inline uint32_t rsf_rd_u32(const uint8_t *p)
-{
-    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
-}
-
-static inline void rsf_wr_u32(uint8_t *p, uint32_t v)
-{
-    p[0] = (uint8_t)v;
-    p[1] = (uint8_t)(v >> 8);
-    p[2] = (uint8_t)(v >> 16);
-    p[3] = (uint8_t)(v >> 24);
-}
 
 static inline size_t rsf_align16(size_t n) { return (n + RSF_PAYLOAD_ALIGN - 1) / RSF_PAYLOAD_ALIGN * RSF_PAYLOAD_ALIGN; }
 

@@ -222,22 +222,14 @@ int main(int argc, char **argv)
             else if (!strcmp(a, "--notes")) notes = v;
             else if (!strcmp(a, "--preview")) preview = v;
             else if (!strcmp(a, "--light-near")) {
-                char *end;
-                errno = 0;
-                desc.light_near_uv[0] = strtof(v, &end);
-                bool ok = end != v && *end == ',' && errno == 0;
-                const char *v2 = end + 1;
-                if (ok) desc.light_near_uv[1] = strtof(v2, &end);
-                ok = ok && end != v2 && !*end && errno == 0;
-                for (int k = 0; k < 2 && ok; k++) ok = desc.light_near_uv[k] >= 0.0f && desc.light_near_uv[k] <= 1.0f;
-                if (!ok) return usage("--light-near: U,V of the source image, each 0..1 (e.g. 0.55,0.4)");
+                double uv[2];
+                if (!rs_parse_list(v, ',', 2, 0.0, 1.0, uv)) return usage("--light-near: U,V of the source image, each 0..1 (e.g. 0.55,0.4)");
+                desc.light_near_uv[0] = (float)uv[0], desc.light_near_uv[1] = (float)uv[1];
                 desc.light_near = true;
             } else {
-                char *end;
-                errno = 0;
-                key_yaw = strtof(v, &end);
-                if (end == v || *end || errno || !isfinite(key_yaw) || fabsf(key_yaw) > 360.0f)
-                    return usage("--key-yaw: a number of degrees in -360..360");
+                double yaw;
+                if (!rs_parse_number(v, -360.0, 360.0, &yaw)) return usage("--key-yaw: a number of degrees in -360..360");
+                key_yaw = (float)yaw;
             }
         } else if (a[0] == '-' && a[1]) {
             char msg[160];
