@@ -28,7 +28,8 @@ viewer_look_saved_and_loaded_renders_the_same viewer_records_a_replayable_stroke
 viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_one_line
 viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
 viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file
-viewer_streamed_face_draws_the_first_level_before_the_rest viewer_stdin_not_a_face_exits_with_one_line"
+viewer_streamed_face_draws_the_first_level_before_the_rest viewer_stdin_not_a_face_exits_with_one_line
+viewer_and_rouge_render_show_the_same_look"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -294,6 +295,33 @@ if selected viewer_s_saves_at_full_quality; then
         m=$("$imgdiff" "$out/s_early/rouge-0001.png" "$out/s_late/rouge-0001.png" 2>&1 | awk '/^max_abs/ {print $2}')
         if [ -n "$m" ] && [ "$m" -le 2 ]; then echo "ok - $name"
         else echo "FAIL - $name: the early shot differs from the refined one (max_abs ${m:-error})"; fi
+    fi
+fi
+if selected viewer_and_rouge_render_show_the_same_look; then
+    # A lipstick stroke along the lips in the window, saved with S (full quality) and recorded; the recording
+    # replayed by `rouge render` (the public API) at the same size and splat budget must give the same
+    # picture: the two paths share the pipeline, the makeup uniforms and the default lighting.
+    name=viewer_and_rouge_render_show_the_same_look
+    abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
+    abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
+    abs_out=$(cd "$out" && pwd)
+    rm -rf "$out/same" && mkdir -p "$out/same"
+    printf 'key i\nmove 400 580\nidle\nkey s\nidle\nkey p\nkey 9\ndrag 372 421 428 421 20\nmove 400 580\nidle\nkey s\nidle\nquit\n' \
+        >"$out/same.events"
+    (cd "$out/same" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+        --events "$abs_out/same.events" --record "$abs_out/same/look.strokes" >"$abs_out/same.log" 2>&1)
+    if [ ! -f "$out/same/rouge-0002.png" ] || [ ! -s "$out/same/look.strokes" ]; then
+        echo "FAIL - $name: no screenshot or recording ($(tail -c 200 "$out/same.log"))"
+    elif ! timeout 180 "$rouge" render "$face" --strokes "$out/same/look.strokes" --size 800x600 --max-splats 100000 \
+        --pipeline mobile -o "$out/same/render.png" >"$out/same_render.log" 2>&1; then
+        echo "FAIL - $name: rouge render failed: $(tail -c 300 "$out/same_render.log")"
+    else
+        # Same look: within 8 levels nearly everywhere; and the stroke is really there (the viewer's shot
+        # before painting differs).
+        same=$("$imgdiff" "$out/same/rouge-0002.png" "$out/same/render.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
+        painted=$("$imgdiff" "$out/same/rouge-0001.png" "$out/same/rouge-0002.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
+        if awk -v s="${same:-1}" -v p="${painted:-0}" 'BEGIN {exit !(s <= 0.0005 && p >= 0.002)}'; then echo "ok - $name"
+        else echo "FAIL - $name: viewer vs render: ${same:-error} of pixels over 8; the stroke changed ${painted:-error} ($out/same)"; fi
     fi
 fi
 if selected viewer_streamed_face_draws_the_first_level_before_the_rest; then
