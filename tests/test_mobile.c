@@ -5,6 +5,7 @@
 // (albedo) floor skipping shadows and diffusion, and the usual robustness checks on the new paths.
 // The bench (make bench) runs the whole set: 8 views x 2 lights x 2 modes.
 #include "support/harness.h"
+#include "support/face_fixture.h"
 #include "formats/env_lookup.h"
 #include "render/render.h"
 
@@ -13,10 +14,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-static rs_gl_context *gl;
-static rs_splat_cloud *face;
+static rs_test_face tf;
+static rs_splat_cloud *face;  // tf.cloud and tf.ren, by their short names
 static rs_renderer *ren;
-static char face_why[600];
 
 // The fixed view set of the tolerance (tools/rouge_bench.c uses the same): camera yaw/pitch, key light
 // yaw/pitch.
@@ -33,12 +33,7 @@ static rs_view test_view(rs_render_mode mode, int size)
     return v;
 }
 
-static bool need_face(void)
-{
-    if (face && ren) return true;
-    rs_test_skip("%s", face_why);
-    return false;
-}
+static bool need_face(void) { return rs_test_face_ready(&tf); }
 
 static bool render(rs_renderer *r, const rs_view *v, rs_image *img)
 {
@@ -65,42 +60,6 @@ static bool interior(const rs_image *img, int x, int y, int margin)
             if (xx < 0 || yy < 0 || xx >= img->width || yy >= img->height || is_background(img, xx, yy)) return false;
         }
     return true;
-}
-
-// Background pixels not connected to the image border: holes inside the silhouette.
-static int count_holes(const rs_image *img, int *face_px)
-{
-    int w = img->width, h = img->height, n = w * h;
-    uint8_t *seen = calloc((size_t)n, 1);
-    int *stack = malloc(sizeof(int) * (size_t)n * 4 + 64);
-    if (!seen || !stack) {
-        free(seen);
-        free(stack);
-        return -1;
-    }
-    int sp = 0;
-    for (int x = 0; x < w; x++) stack[sp++] = x, stack[sp++] = (h - 1) * w + x;
-    for (int y = 0; y < h; y++) stack[sp++] = y * w, stack[sp++] = y * w + w - 1;
-    while (sp) {
-        int i = stack[--sp];
-        if (seen[i] || !is_background(img, i % w, i / w)) continue;
-        seen[i] = 1;
-        int x = i % w, y = i / w;
-        if (x > 0) stack[sp++] = i - 1;
-        if (x < w - 1) stack[sp++] = i + 1;
-        if (y > 0) stack[sp++] = i - w;
-        if (y < h - 1) stack[sp++] = i + w;
-    }
-    int holes = 0, fg = 0;
-    for (int i = 0; i < n; i++) {
-        bool bg = is_background(img, i % w, i / w);
-        fg += !bg;
-        holes += bg && !seen[i];
-    }
-    free(seen);
-    free(stack);
-    *face_px = fg;
-    return holes;
 }
 
 static void save_pair(const char *name, const rs_image *a, const rs_image *b)
@@ -404,7 +363,7 @@ static void test_mobile_lod_leaves_no_holes(void)
         v.yaw_deg = i ? 60.0f : 0.0f, v.pitch_deg = i ? 15.0f : 0.0f;
         rs_image img = {0};
         if (!render(ren, &v, &img)) return;
-        int fg = 0, holes = count_holes(&img, &fg);
+        int fg = 0, holes = rs_test_count_holes(&img, img.pixels, &fg);
         RS_CHECK(rs_render_get_stats(ren).splats_drawn < face->hdr.count, "no decimation at 384x384");
         RS_CHECK(holes == 0, "yaw %g: %d holes in %d face pixels (%u splats)", v.yaw_deg, holes, fg,
                  rs_render_get_stats(ren).splats_drawn);
@@ -419,7 +378,7 @@ static void test_albedo_mode_skips_shadow_and_diffusion(void)
     if (!need_face()) return;
     rs_renderer *r = NULL;
     rs_error err = {0};
-    RS_REQUIRE(rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &r, &err) == RS_OK, "%s",
+    RS_REQUIRE(rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(tf.gl)}, &r, &err) == RS_OK, "%s",
                err.msg);
     size_t bytes[3] = {0};
     for (int p = 0; p < 2; p++) {
@@ -475,7 +434,7 @@ static void test_mobile_rgba8_fallback_runs_and_is_close(void)
     if (!need_face()) return;
     rs_renderer *r8 = NULL;
     rs_error err = {0};
-    rs_render_desc desc = {.cloud = face, .caps = rs_gl_get_caps(gl), .force_no_float_targets = true};
+    rs_render_desc desc = {.cloud = face, .caps = rs_gl_get_caps(tf.gl), .force_no_float_targets = true};
     RS_REQUIRE(rs_render_create(&desc, &r8, &err) == RS_OK, "%s", err.msg);
     rs_view v = test_view(RS_MODE_FULL, 256);
     v.pipeline = RS_PIPELINE_MOBILE;
@@ -508,21 +467,8 @@ static void test_mobile_pick_returns_splat_of_drawn_prefix(void)
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
-    rs_error err = {0};
-    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
-        printf("FAIL - mobile_gl_context: %s\n", err.msg);
-        return 1;
-    }
-    const char *path = getenv("RS_TEST_FACE");
-    if (!path || !*path) path = "assets/face.rsf";
-    if (rs_splat_load(path, &face, &err) != RS_OK) {
-        snprintf(face_why, sizeof face_why, "no test face: %s", err.msg);
-    } else if (rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &ren, &err) != RS_OK) {
-        printf("FAIL - mobile_render_create: %s\n", err.msg);
-        rs_splat_destroy(face);
-        rs_gl_destroy(gl);
-        return 1;
-    }
+    if (!rs_test_face_open("mobile", &tf)) return 1;
+    face = tf.cloud, ren = tf.ren;
     RS_RUN(test_lod_prefix_follows_projected_density);
     RS_RUN(test_face_area_estimate_matches_covered_pixels);
     RS_RUN(test_mobile_lod_leaves_no_holes);
@@ -533,8 +479,6 @@ int main(int argc, char **argv)
     RS_RUN(test_k3_fit_matches_six_gaussians_at_a_shadow_edge);
     RS_RUN(test_mobile_matches_reference_within_tolerance_at_512);
     RS_RUN(test_mobile_matches_reference_under_environments);
-    rs_render_destroy(ren);
-    rs_splat_destroy(face);
-    rs_gl_destroy(gl);
+    rs_test_face_close(&tf);
     return rs_test_finish();
 }

@@ -12,6 +12,7 @@
 // render of the same view by more than MASK_T levels in some channel. RS_TEST_VERBOSE=1 prints the
 // measured values. About 15 s on llvmpipe.
 #include "support/harness.h"
+#include "support/face_fixture.h"
 #include "formats/look.h"
 #include "paint/paint.h"
 #include "render/render.h"
@@ -27,10 +28,9 @@
 #define MAX_SPLATS 50000
 #define MASK_T 3  // levels: above rounding noise, below what a stamp's soft rim still changes
 
-static rs_gl_context *gl;
-static rs_splat_cloud *face;
+static rs_test_face tf;
+static rs_splat_cloud *face;  // tf.cloud and tf.ren, by their short names
 static rs_renderer *ren;
-static char face_why[600];
 static rs_makeup_gpu *zeros;  // face->hdr.count zero records: resets the renderer's layer
 
 // With RS_TEST_VERBOSE=1 the measured values are printed as "# ..." lines (for tuning bounds).
@@ -58,18 +58,9 @@ static rs_view test_view(rs_render_mode mode)
     return v;
 }
 
-static bool need_face(void)
-{
-    if (face && ren) return true;
-    rs_test_skip("%s", face_why);
-    return false;
-}
+static bool need_face(void) { return rs_test_face_ready(&tf); }
 
-static bool render(const rs_view *v, rs_image *img)
-{
-    rs_error err = {0};
-    return RS_CHECK(rs_render_image(ren, v, img, &err) == RS_OK, "render: %s", err.msg);
-}
+static bool render(const rs_view *v, rs_image *img) { return rs_test_render(ren, v, img); }
 
 static bool render_mode(rs_render_mode mode, rs_image *img)
 {
@@ -1032,20 +1023,10 @@ static void test_glsl_makeup_compose_matches_cpu_mirror(void)
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
-    rs_error err = {0};
-    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
-        printf("FAIL - paint_render_gl_context: %s\n", err.msg);
-        return 1;
-    }
-    const char *path = getenv("RS_TEST_FACE");
-    if (!path || !*path) path = "assets/face.rsf";
-    if (rs_splat_load(path, &face, &err) != RS_OK) {
-        snprintf(face_why, sizeof face_why, "no test face: %s", err.msg);
-    } else if (!(zeros = calloc(face->hdr.count, sizeof *zeros))) {
+    if (!rs_test_face_open("paint_render", &tf)) return 1;
+    face = tf.cloud, ren = tf.ren;
+    if (face && !(zeros = calloc(face->hdr.count, sizeof *zeros))) {
         printf("FAIL - paint_render_alloc: out of memory\n");
-        return 1;
-    } else if (rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &ren, &err) != RS_OK) {
-        printf("FAIL - paint_render_create: %s\n", err.msg);
         return 1;
     }
     RS_RUN(test_lip_stroke_lands_on_the_lips_where_it_was_drawn);
@@ -1060,9 +1041,7 @@ int main(int argc, char **argv)
     RS_RUN(test_saved_look_renders_identically_on_the_same_and_a_coarser_lod);
     RS_RUN(test_mirror_painting_is_symmetric_about_the_mid_plane);
     RS_RUN(test_glsl_makeup_compose_matches_cpu_mirror);
-    rs_render_destroy(ren);
-    rs_splat_destroy(face);
     free(zeros);
-    rs_gl_destroy(gl);
+    rs_test_face_close(&tf);
     return rs_test_finish();
 }

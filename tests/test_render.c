@@ -4,6 +4,7 @@
 //
 // Lit-image checks read linear output (rs_view.linear_output) so sums and ratios are in light units.
 #include "support/harness.h"
+#include "support/face_fixture.h"
 #include "render/render.h"
 
 #include <math.h>
@@ -14,10 +15,9 @@
 #define SIZE 256
 #define MAX_SPLATS 50000
 
-static rs_gl_context *gl;
-static rs_splat_cloud *face;
+static rs_test_face tf;
+static rs_splat_cloud *face;  // tf.cloud and tf.ren, by their short names
 static rs_renderer *ren;
-static char face_why[600];
 
 // ---- helpers ----
 
@@ -33,18 +33,9 @@ static rs_view test_view(rs_render_mode mode)
     return v;
 }
 
-static bool need_face(void)
-{
-    if (face && ren) return true;
-    rs_test_skip("%s", face_why);
-    return false;
-}
+static bool need_face(void) { return rs_test_face_ready(&tf); }
 
-static bool render(const rs_view *v, rs_image *img)
-{
-    rs_error err = {0};
-    return RS_CHECK(rs_render_image(ren, v, img, &err) == RS_OK, "render: %s", err.msg);
-}
+static bool render(const rs_view *v, rs_image *img) { return rs_test_render(ren, v, img); }
 
 static const uint8_t *px(const rs_image *img, int x, int y) { return img->pixels + ((size_t)y * img->width + x) * img->channels; }
 
@@ -67,42 +58,6 @@ static bool interior(const rs_image *img, int x, int y, int margin)
                 return false;
         }
     return true;
-}
-
-// Background pixels not connected to the image border: holes inside the silhouette.
-static int count_holes(const rs_image *img, int *face_px)
-{
-    int w = img->width, h = img->height, n = w * h;
-    uint8_t *seen = calloc((size_t)n, 1);
-    int *stack = malloc(sizeof(int) * (size_t)n * 4 + 64);
-    if (!seen || !stack) {
-        free(seen);
-        free(stack);
-        return -1;
-    }
-    int sp = 0;
-    for (int x = 0; x < w; x++) stack[sp++] = x, stack[sp++] = (h - 1) * w + x;
-    for (int y = 0; y < h; y++) stack[sp++] = y * w, stack[sp++] = y * w + w - 1;
-    while (sp) {
-        int i = stack[--sp];
-        if (seen[i] || !is_background(img, i % w, i / w)) continue;
-        seen[i] = 1;
-        int x = i % w, y = i / w;
-        if (x > 0) stack[sp++] = i - 1;
-        if (x < w - 1) stack[sp++] = i + 1;
-        if (y > 0) stack[sp++] = i - w;
-        if (y < h - 1) stack[sp++] = i + w;
-    }
-    int holes = 0, fg = 0;
-    for (int i = 0; i < n; i++) {
-        bool bg = is_background(img, i % w, i / w);
-        fg += !bg;
-        holes += bg && !seen[i];
-    }
-    free(seen);
-    free(stack);
-    *face_px = fg;
-    return holes;
 }
 
 // The splat furthest along the face's forward axis: the nose tip on a front-facing head.
@@ -153,7 +108,7 @@ static void test_visibility_leaves_no_holes_inside_silhouette(void)
     rs_view v = test_view(RS_MODE_ALBEDO);
     rs_image img = {0};
     if (!render(&v, &img)) return;
-    int fg = 0, holes = count_holes(&img, &fg);
+    int fg = 0, holes = rs_test_count_holes(&img, (const uint8_t[3]){255, 0, 255}, &fg);
     RS_CHECK(fg > SIZE * SIZE / 8, "the face covers only %d pixels", fg);
     RS_CHECK(holes == 0, "%d background pixels inside the silhouette (of %d face pixels)", holes, fg);
     if (holes) rs_test_save("render_holes", &img);
@@ -169,7 +124,7 @@ static void test_coarse_lod_and_side_view_have_no_holes(void)
     v.pitch_deg = 15.0f;
     rs_image img = {0};
     if (!render(&v, &img)) return;
-    int fg = 0, holes = count_holes(&img, &fg);
+    int fg = 0, holes = rs_test_count_holes(&img, (const uint8_t[3]){255, 0, 255}, &fg);
     RS_CHECK(holes == 0, "%d holes at 20k splats, yaw 60 (%d face pixels)", holes, fg);
     if (holes) rs_test_save("render_holes_coarse", &img);
     rs_image_free(&img);
@@ -475,7 +430,7 @@ static void test_rgba8_fallback_is_close_to_float_targets(void)
     if (!need_face()) return;
     rs_renderer *r8 = NULL;
     rs_error err = {0};
-    RS_REQUIRE(rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl),
+    RS_REQUIRE(rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(tf.gl),
                                                   .force_no_float_targets = true},
                                 &r8, &err) == RS_OK,
                "%s", err.msg);
@@ -675,21 +630,8 @@ static void test_debug_views_show_what_they_name(void)
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
-    rs_error err = {0};
-    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
-        printf("FAIL - render_gl_context: %s\n", err.msg);
-        return 1;
-    }
-    const char *path = getenv("RS_TEST_FACE");
-    if (!path || !*path) path = "assets/face.rsf";
-    if (rs_splat_load(path, &face, &err) != RS_OK) {
-        snprintf(face_why, sizeof face_why, "no test face: %s", err.msg);
-    } else if (rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &ren, &err) != RS_OK) {
-        printf("FAIL - render_create: %s\n", err.msg);
-        rs_splat_destroy(face);
-        rs_gl_destroy(gl);
-        return 1;
-    }
+    if (!rs_test_face_open("render", &tf)) return 1;
+    face = tf.cloud, ren = tf.ren;
     RS_RUN(test_visibility_leaves_no_holes_inside_silhouette);
     RS_RUN(test_coarse_lod_and_side_view_have_no_holes);
     RS_RUN(test_points_and_quads_give_the_same_image);
@@ -710,8 +652,6 @@ int main(int argc, char **argv)
     RS_RUN(test_frame_restores_gl_state);
     RS_RUN(test_makeup_records_reach_the_attribute_pass);
     RS_RUN(test_debug_views_show_what_they_name);
-    rs_render_destroy(ren);
-    rs_splat_destroy(face);
-    rs_gl_destroy(gl);
+    rs_test_face_close(&tf);
     return rs_test_finish();
 }

@@ -259,13 +259,7 @@ rs_result rs_look_write_memory(const rs_makeup *mk, char **out, size_t *out_len,
     if (n) PUT("end\n");
 #undef PUT
     free(remap);
-    if (w.failed) {
-        free(w.p);
-        return rs_fail(err, RS_ERR_NOMEM, "look: writing %u stamps: out of memory", n);
-    }
-    *out = w.p;
-    *out_len = w.len;
-    return RS_OK;
+    return rs_text_writer_finish(&w, "look", out, out_len, err);
 }
 
 rs_result rs_look_save(const rs_makeup *mk, const char *path, rs_error *err)

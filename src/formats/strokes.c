@@ -396,13 +396,7 @@ rs_result rs_strokes_write_memory(const rs_strokes *doc, char **out, size_t *out
         rs_text_printf(&b, "end\n");
         prev = s;
     }
-    if (b.failed) {
-        free(b.p);
-        return rs_fail(err, RS_ERR_NOMEM, "strokes: writing: out of memory");
-    }
-    *out = b.p;
-    *out_len = b.len;
-    return RS_OK;
+    return rs_text_writer_finish(&b, "strokes", out, out_len, err);
 }
 
 rs_result rs_strokes_save(const rs_strokes *doc, const char *path, rs_error *err)

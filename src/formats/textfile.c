@@ -89,3 +89,16 @@ void rs_text_printf(rs_text_writer *w, const char *fmt, ...)
         w->cap = cap;
     }
 }
+
+rs_result rs_text_writer_finish(rs_text_writer *w, const char *what, char **out, size_t *out_len, rs_error *err)
+{
+    if (w->failed || !w->p) {
+        free(w->p);
+        *w = (rs_text_writer){0};
+        return rs_fail(err, RS_ERR_NOMEM, "%s: writing: out of memory", what);
+    }
+    *out = w->p;
+    *out_len = w->len;
+    *w = (rs_text_writer){0};
+    return RS_OK;
+}

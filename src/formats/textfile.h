@@ -39,5 +39,8 @@ typedef struct rs_text_writer {
     bool failed;
 } rs_text_writer;
 void rs_text_printf(rs_text_writer *w, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+// Hands the text over (*out, *out_len; the caller frees it) or, after a failed allocation, frees it and
+// fails with "WHAT: writing: out of memory".
+rs_result rs_text_writer_finish(rs_text_writer *w, const char *what, char **out, size_t *out_len, rs_error *err);
 
 #endif
