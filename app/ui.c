@@ -489,6 +489,10 @@ void rs_ui_icon_draw(rs_ui *ui, rs_ui_icon icon, rs_ui_rect r, rs_ui_rgba c)
         A(&p, 12, 14.5f, 5.5f, 200, 340);
         L(&p, 6.9f, 12.6f, 12, 3.5f), L(&p, 17.1f, 12.6f, 12, 3.5f);
         break;
+    case RS_UI_ICON_REGION:  // a dashed outline (the region) holding a dot of paint
+        for (int i = 0; i < 8; i++) A(&p, 12, 12, 8.5f, (float)i * 45.0f + 8.0f, (float)i * 45.0f + 30.0f);
+        D(&p, 12, 12, 4.0f);
+        break;
     case RS_UI_ICON_CLOSE:
         L(&p, 6, 6, 18, 18), L(&p, 18, 6, 6, 18);
         break;

@@ -61,6 +61,7 @@ typedef enum rs_ui_icon {
     RS_UI_ICON_DROP,      // opacity
     RS_UI_ICON_CLOSE,
     RS_UI_ICON_CHEVRONS,  // < > on the split divider
+    RS_UI_ICON_REGION,    // the brush keeps to the product's region (a dot inside a dashed outline)
     RS_UI_ICON_COUNT
 } rs_ui_icon;
 
@@ -138,13 +139,14 @@ rs_ui_rect rs_ui_rect_inset(rs_ui_rect r, float d);
 
 // --- the makeup toolbar ---------------------------------------------------------------------------
 // Everything a person taps. Panels: top bar (render mode, pipeline, split, HUD, save/load, screenshot,
-// help), left rail (paint/view, eraser, mirror, undo, redo, clear), right rail (light dial, brush size,
+// help), left rail (paint/view, eraser, mirror, region, undo, redo, clear), right rail (light dial, brush size,
 // opacity) and bottom sheet (cosmetic swatches with the selected product's name).
 typedef enum rs_ui_tool {
     RS_UI_TOOL_NONE = 0,
     RS_UI_TOOL_PAINT,         // toggles paint / view mode
     RS_UI_TOOL_ERASER,
     RS_UI_TOOL_MIRROR,
+    RS_UI_TOOL_REGION,        // region-aware brush on/off
     RS_UI_TOOL_UNDO,
     RS_UI_TOOL_REDO,
     RS_UI_TOOL_CLEAR,
@@ -180,10 +182,11 @@ typedef struct rs_ui_toolbar_state {
     int swatch_count;                      // <= RS_UI_TOOLBAR_MAX_SWATCHES
     const uint8_t (*swatch_rgb)[3];        // sRGB per swatch
     const char *const *swatch_name;        // display names (may be NULL)
+    const char *region_name;               // where the brush stays ("lips"), shown by the name; NULL: anywhere
     int selected;                          // swatch index, -1 none
     float size, opacity;                   // slider values 0..1 (the viewer maps them to brush units)
     float light[2];                        // light dial position in the unit disc (x right, y up)
-    bool paint, eraser, mirror, split, hud, help;
+    bool paint, eraser, mirror, keep_region, split, hud, help;
     bool can_undo, can_redo;
     int mode;                              // 0 albedo, 1 diffuse, 2 full
     bool mobile;                           // pipeline: mobile (true) or reference

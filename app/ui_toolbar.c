@@ -3,6 +3,7 @@
 #include "ui.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 // Touch targets: 48 points, the common mobile guideline (Material: 48 dp; Apple: 44 pt minimum).
@@ -19,8 +20,9 @@
 
 static const rs_ui_tool top_icons[] = {RS_UI_TOOL_SPLIT, RS_UI_TOOL_HUD, RS_UI_TOOL_SAVE,
                                        RS_UI_TOOL_LOAD, RS_UI_TOOL_SCREENSHOT, RS_UI_TOOL_HELP};
-static const rs_ui_tool left_tools[] = {RS_UI_TOOL_PAINT, RS_UI_TOOL_ERASER, RS_UI_TOOL_MIRROR,
-                                        RS_UI_TOOL_UNDO, RS_UI_TOOL_REDO, RS_UI_TOOL_CLEAR};
+static const rs_ui_tool left_tools[] = {RS_UI_TOOL_PAINT, RS_UI_TOOL_ERASER, RS_UI_TOOL_MIRROR, RS_UI_TOOL_REGION,
+                                        RS_UI_TOOL_UNDO,  RS_UI_TOOL_REDO,   RS_UI_TOOL_CLEAR};
+#define LEFT_N ((int)RS_COUNT_OF(left_tools))
 
 void rs_ui_toolbar_layout_compute(int fb_w, int fb_h, float scale, int swatch_count, rs_ui_toolbar_layout *out)
 {
@@ -33,7 +35,7 @@ void rs_ui_toolbar_layout_compute(int fb_w, int fb_h, float scale, int swatch_co
     float top_w_pt = 2 * PAD_PT + 3 * SEG_W_PT + SEP_PT + PIPE_W_PT + SEP_PT + 6 * TARGET_PT;
     s = RS_MIN(s, (W - 2 * MARGIN_PT * s) / top_w_pt);
     // ... and the height must hold the top bar, the left rail and the bottom sheet.
-    float h_pt = 2 * MARGIN_PT + (TARGET_PT + 2 * PAD_PT) + (2 * PAD_PT + 6 * TARGET_PT + SEP_PT) +
+    float h_pt = 2 * MARGIN_PT + (TARGET_PT + 2 * PAD_PT) + (2 * PAD_PT + LEFT_N * TARGET_PT + SEP_PT) +
                  (2 * PAD_PT + LABEL_H_PT + TARGET_PT) + 2 * GAP_PT;
     s = RS_MIN(s, H / h_pt);
     s = RS_MAX(s, 0.25f);
@@ -66,7 +68,7 @@ void rs_ui_toolbar_layout_compute(int fb_w, int fb_h, float scale, int swatch_co
 
     // Side rails fill the band between the top bar and the bottom sheet.
     float band0 = out->top.y + out->top.h + g, band1 = out->bottom.y - g;
-    float lh = 2 * pad + 6 * t + SEP_PT * s;
+    float lh = 2 * pad + LEFT_N * t + SEP_PT * s;
     out->left = (rs_ui_rect){m, floorf(band0 + RS_MAX(0.0f, (band1 - band0 - lh) * 0.5f)), t + 2 * pad, lh};
     y = out->left.y + pad;
     for (size_t i = 0; i < RS_COUNT_OF(left_tools); i++) {
@@ -161,11 +163,11 @@ rs_ui_tool rs_ui_toolbar(rs_ui *ui, const rs_ui_toolbar_layout *l, rs_ui_toolbar
         if (rs_ui_button(ui, (int)(1000 + top_icons[i]), l->tool[top_icons[i]], top_icon[i], top_on[i]))
             hit = top_icons[i];
 
-    // Left rail: paint/view, eraser, mirror | undo, redo, clear.
+    // Left rail: paint/view, eraser, mirror, region | undo, redo, clear.
     rs_ui_panel(ui, l->left, rad);
-    static const rs_ui_icon left_icon[] = {RS_UI_ICON_BRUSH, RS_UI_ICON_ERASER, RS_UI_ICON_MIRROR,
-                                           RS_UI_ICON_UNDO, RS_UI_ICON_REDO, RS_UI_ICON_TRASH};
-    const bool left_on[] = {st->paint, st->eraser, st->mirror, false, false, false};
+    static const rs_ui_icon left_icon[] = {RS_UI_ICON_BRUSH, RS_UI_ICON_ERASER, RS_UI_ICON_MIRROR, RS_UI_ICON_REGION,
+                                           RS_UI_ICON_UNDO,  RS_UI_ICON_REDO,   RS_UI_ICON_TRASH};
+    const bool left_on[] = {st->paint, st->eraser, st->mirror, st->keep_region, false, false, false};
     for (size_t i = 0; i < RS_COUNT_OF(left_tools); i++) {
         rs_ui_tool t = left_tools[i];
         rs_ui_icon icon = t == RS_UI_TOOL_PAINT && !st->paint ? RS_UI_ICON_MOVE : left_icon[i];
@@ -199,9 +201,13 @@ rs_ui_tool rs_ui_toolbar(rs_ui *ui, const rs_ui_toolbar_layout *l, rs_ui_toolbar
             hit = RS_UI_TOOL_SWATCH, st->selected = i, st->eraser = false;
             if (swatch) *swatch = i;
         }
-    const char *name = st->eraser ? "Eraser"
-                       : (st->selected >= 0 && st->selected < n && st->swatch_name) ? st->swatch_name[st->selected]
-                                                                                    : "";
+    // "Lipstick matte - on lips" while the brush keeps to the product's region.
+    const char *product = st->eraser ? "Eraser"
+                          : (st->selected >= 0 && st->selected < n && st->swatch_name) ? st->swatch_name[st->selected]
+                                                                                       : "";
+    char name[96];
+    if (!st->eraser && st->region_name) snprintf(name, sizeof name, "%s - on %s", product, st->region_name);
+    else snprintf(name, sizeof name, "%s", product);
     int ts = RS_MAX(1, (int)floorf(s * 2 + 0.25f));
     float nw = rs_ui_text_width(name, ts);
     rs_ui_text(ui, l->label.x + (l->label.w - nw) * 0.5f, l->label.y + (l->label.h - 7.0f * (float)ts) * 0.5f, ts,

@@ -57,6 +57,7 @@ const vw_shortcut vw_shortcuts[] = {
     {"1-9, Tab", "pick a cosmetic; Tab: next"},
     {"[ ], Shift+[ ]", "brush size, opacity"},
     {"E, M", "eraser, mirror painting"},
+    {"K", "keep the brush to its region"},
     {"Ctrl+Z, Ctrl+Y", "undo, redo"},
     {"Delete", "clear all makeup"},
     {"A, D, F", "albedo / diffuse / full"},
@@ -154,10 +155,27 @@ static void apply_brush(vw_viewer *v)
     if (!v->paint) return;
     rs_paint_brush b = {.cosmetic = *rs_cosmetic_get((uint32_t)v->cosmetic), .size_rel = v->size_rel,
                         .opacity = v->opacity, .pressure = RS_MAKEUP_PRESSURE_FLOOR, .eraser = v->eraser,
-                        .mirror = v->mirror};
+                        .mirror = v->mirror, .any_region = v->any_region};
     rs_paint_set_brush(v->paint, &b);
     // A preview's makeup would be lost when the whole face replaces it: painting waits for the rest.
     rs_paint_set_mode(v->paint, v->paint_mode && !v->partial ? RS_INPUT_PAINT : RS_INPUT_VIEW);
+}
+
+// Where the current product's brush stays ("lips"), NULL when it paints anywhere.
+const char *vw_brush_region(const vw_viewer *v)
+{
+    rs_cosmetic_region r = rs_cosmetic_region_of(rs_cosmetic_get((uint32_t)v->cosmetic));
+    if (v->any_region || r == RS_COSMETIC_REGION_ANY) return NULL;
+    return rs_cosmetic_region_name(r);
+}
+
+static void toggle_region(vw_viewer *v)
+{
+    v->any_region = !v->any_region;
+    apply_brush(v);
+    const char *r = vw_brush_region(v);
+    if (r) vw_toast(v, false, "Brush keeps to the %s (K: anywhere)", r);
+    else vw_toast(v, false, "Brush paints anywhere (K: keep to the product's region)");
 }
 
 static void select_cosmetic(vw_viewer *v, int i)
@@ -537,6 +555,7 @@ static void key_action(vw_viewer *v, int key, int mods)
     case GLFW_KEY_P: v->paint_mode = !v->paint_mode, apply_brush(v); break;
     case GLFW_KEY_E: v->eraser = !v->eraser, v->paint_mode = true, apply_brush(v); break;
     case GLFW_KEY_M: v->mirror = !v->mirror, apply_brush(v); break;
+    case GLFW_KEY_K: toggle_region(v); break;
     case GLFW_KEY_Z: if (ctrl) do_undo(v, shift); break;
     case GLFW_KEY_Y: if (ctrl) do_undo(v, true); break;
     case GLFW_KEY_DELETE: do_clear(v); break;
@@ -839,6 +858,7 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
     case RS_UI_TOOL_PAINT: v->paint_mode = !v->paint_mode, apply_brush(v); break;
     case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->paint_mode = true, apply_brush(v); break;
     case RS_UI_TOOL_MIRROR: v->mirror = !v->mirror, apply_brush(v); break;
+    case RS_UI_TOOL_REGION: toggle_region(v); break;
     case RS_UI_TOOL_UNDO: do_undo(v, false); break;
     case RS_UI_TOOL_REDO: do_undo(v, true); break;
     case RS_UI_TOOL_CLEAR: do_clear(v); break;

@@ -242,9 +242,10 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
     *st = (rs_ui_toolbar_state){
         .swatch_count = n, .swatch_rgb = (const uint8_t(*)[3])v->swatch_rgb,
         .swatch_name = (const char *const *)v->swatch_name_ptr, .selected = v->cosmetic,
+        .region_name = vw_brush_region(v),
         .size = vw_size_to_slider(v->size_rel), .opacity = v->opacity,
         .light = {v->light_dial[0], v->light_dial[1]}, .paint = v->paint_mode, .eraser = v->eraser,
-        .mirror = v->mirror, .split = v->split, .hud = v->hud, .help = v->help,
+        .mirror = v->mirror, .keep_region = !v->any_region, .split = v->split, .hud = v->hud, .help = v->help,
         .can_undo = rs_makeup_can_undo(v->mk), .can_redo = rs_makeup_can_redo(v->mk),
         .mode = v->view.mode == RS_MODE_ALBEDO ? 0 : v->view.mode == RS_MODE_DIFFUSE ? 1 : 2,
         .mobile = v->view.pipeline == RS_PIPELINE_MOBILE,

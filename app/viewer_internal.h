@@ -207,6 +207,7 @@ typedef struct vw_viewer {
     int cosmetic;  // preset index
     float size_rel, opacity;
     bool eraser, mirror;
+    bool any_region;  // K: paint anywhere instead of keeping to the product's region
 
     // Pointer.
     float mx, my;               // framebuffer pixels
@@ -261,6 +262,8 @@ void vw_toast(vw_viewer *v, bool error, const char *fmt, ...) __attribute__((for
 // Lighting environment by name (bundled, "paper" or a .rse file); false (and a toast) when it cannot load.
 bool vw_set_env(vw_viewer *v, const char *name);
 float vw_size_to_slider(float size_rel);
+// Where the current product's brush stays ("lips", "eyes", "skin"), NULL when it paints anywhere.
+const char *vw_brush_region(const vw_viewer *v);
 // The picker on the picture as shown: framebuffer pixels in, whatever resolution it was rendered at.
 bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index, float hit[3]);
 float vw_pixels_per_unit(void *viewer, const float pos[3]);

@@ -765,8 +765,10 @@ rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge
     if (!(b.size >= 0 && b.size <= 2) || !(b.opacity >= 0 && b.opacity <= 1))
         return fail_arg(err, "brush: size must be 0..2 (face heights), opacity 0..1");
     rs_paint_brush pb = {.cosmetic = *c, .size_rel = b.size, .opacity = b.opacity,
-                         .pressure = (rs_makeup_pressure)b.pressure, .eraser = b.eraser, .mirror = b.mirror};
+                         .pressure = (rs_makeup_pressure)b.pressure, .eraser = b.eraser, .mirror = b.mirror,
+                         .any_region = b.any_region};
     if (!all_zero(b.color, sizeof b.color)) {
+        pb.cosmetic.region_mask = rs_cosmetic_region_of(c);  // a recoloured lipstick still belongs on the lips
         for (int i = 0; i < 3; i++) pb.cosmetic.rgb[i] = (uint8_t)lroundf(RS_CLAMP(b.color[i], 0.0f, 1.0f) * 255.0f);
         snprintf(pb.cosmetic.name, sizeof pb.cosmetic.name, "custom");
         pb.cosmetic.kind = RS_COSMETIC_CUSTOM;

@@ -84,7 +84,7 @@ no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
 expect cli_size_bounded_by_target_memory 1 "needs about 3.7 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
 no_file cli_size_memory_leaves_no_output "$tmp/m.png"
 expect cli_pan_out_of_range 2 "--pan: expected X,Y within -2..2" "$rouge" render "$face" -o "$tmp/p.png" --pan 3,0
-expect cli_target_unknown_region_lists_them 2 "no region 'elbow' in this face (it has other|cheek|nose|forehead|lips)" \
+expect cli_target_unknown_region_lists_them 2 "no region 'elbow' in this face (it has other|cheek|nose|forehead|lips|eyelid|brow)" \
     "$rouge" render "$face" -o "$tmp/p.png" --size 32x32 --max-splats 2000 --target elbow
 no_file cli_target_unknown_leaves_no_output "$tmp/p.png"
 expect cli_second_output_refused 2 "-o given twice" "$rouge" render "$face" -o "$tmp/j.png" -o "$tmp/k.png"

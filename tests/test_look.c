@@ -24,8 +24,10 @@ static rs_splat *plane_splats(uint32_t k, bool lod, uint32_t *coarse)
                 bool is_coarse = (x % 2 == 0) && (y % 2 == 0);
                 if (lod && (pass == 0) != is_coarse) continue;
                 float px = -0.5f + (float)x / (k - 1), py = -0.5f + (float)y / (k - 1);
+                // Lips below y = -0.2 (a region mask has a border to keep to), cheek elsewhere.
                 s[n++] = (rs_splat){{px, py, 0.0f}, {0, 0, 1}, 1.0f / (k - 1),
-                                    {(uint8_t)(190 + 30 * px), (uint8_t)(145 + 20 * py), 125}, 1};
+                                    {(uint8_t)(190 + 30 * px), (uint8_t)(145 + 20 * py), 125},
+                                    py < -0.2f ? RS_REGION_LIPS : RS_REGION_CHEEK};
             }
     if (coarse) *coarse = ((k + 1) / 2) * ((k + 1) / 2);
     return s;
@@ -69,7 +71,7 @@ static void line(rs_makeup *mk, float x0, float y0, float x1, float y1, rs_makeu
 }
 
 // A session with everything a look must carry: presets, a custom product, pressure, mirror, eraser,
-// an undone stroke, a clear before the final strokes.
+// an undone stroke, a clear before the final strokes, a stroke kept to the lips across their border.
 static void paint_session(rs_makeup *mk)
 {
     rs_error err = {0};
@@ -83,6 +85,10 @@ static void paint_session(rs_makeup *mk)
     d.cosmetic = rs_cosmetic_find("lip_gloss");
     d.radius = 0.04f;
     line(mk, -0.1f, -0.3f, 0.1f, -0.3f, d);
+    d.cosmetic = rs_cosmetic_find("lipstick_matte");
+    d.region_mask = true;
+    line(mk, 0.0f, -0.1f, 0.0f, -0.35f, d);
+    d.region_mask = false;
     static rs_cosmetic custom;
     custom = rs_cosmetic_custom((const uint8_t[3]){150, 40, 140}, 0.55f, 0.31f, 0.17f);
     d.cosmetic = &custom;
@@ -124,6 +130,7 @@ static void test_look_round_trip_is_identical(void)
     if (!RS_CHECK(rs_look_parse(text, len, &look, &err) == RS_OK, "%s", err.msg)) return;
     RS_CHECK(look->cosmetic_count >= 3 && look->stamp_count > 60, "%u cosmetics, %u stamps", look->cosmetic_count,
              look->stamp_count);
+    RS_CHECK(strstr(text, " mask\n") != NULL, "the masked stroke's stamps are not marked in the text");
     rs_makeup_range dirty;
     REQUIRE(rs_look_apply(look, other, &dirty, &err) == RS_OK);
     RS_CHECK(same_layers(mk, other), "replayed look differs from the painted layer");
@@ -234,6 +241,8 @@ static void test_malformed_looks_fail_with_line_and_field(void)
         {"stroke\np 0 0 0 0 0 1 0.1 0.5 1\nend\n", true, "not a defined cosmetic index"},
         {"stroke\np 0 0 0 0 0 1 0.1 0.5 -1\nend\n", true, "not a defined cosmetic index"},
         {"stroke\np 0 0 0 0 0 1 0.1 0.5 0 9\nend\n", true, "unexpected text"},
+        {"stroke\np 0 0 0 0 0 1 0.1 0.5 0 mask 9\nend\n", true, "unexpected text"},
+        {"stroke\ne 0 0 0 0 0 1 0.1 0.5 mask\nend\n", true, "unexpected text"},
         {"stroke\np 0 0 0 0 0 1 0 0.5 0\nend\n", true, "radius: 0"},
         {"stroke\np 0 0 0 0 0 1 0.1 1.5 0\nend\n", true, "amount: 1.5"},
         {"stroke\np 0 nan 0 0 0 1 0.1 0.5 0\nend\n", true, "y: 'nan'"},

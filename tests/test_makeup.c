@@ -807,6 +807,108 @@ static void test_overlapping_passes_build_up_without_banding(void)
     rs_splat_destroy(c);
 }
 
+// ---------------------------------------------------------------------------------------------------
+// Region masks (region-aware brushes)
+
+// A plane split down x = 0: lips on the left (x < 0), `other` on the right; 0.38 mm spacing.
+static rs_splat_cloud *split_plane(void)
+{
+    enum { K = 201 };
+    rs_splat *s = rs_alloc_array((size_t)K * K, sizeof *s);
+    if (!s) return NULL;
+    float side = 0.4f, step = side / (K - 1);
+    for (uint32_t y = 0; y < K; y++)
+        for (uint32_t x = 0; x < K; x++) {
+            float px = -0.5f * side + step * x;
+            s[y * K + x] = (rs_splat){{px, -0.5f * side + step * y, 0}, {0, 0, 1}, step, {196, 150, 128},
+                                      px < -1e-6f ? RS_REGION_LIPS : RS_REGION_OTHER};
+        }
+    rs_splat_cloud *c = make_cloud(s, K * K, frame(1.0f));
+    free(s);
+    return c;
+}
+
+static void test_region_mask_is_zero_outside_and_rises_softly_inside(void)
+{
+    rs_splat_cloud *c = split_plane();
+    rs_makeup *mk = layer(c, NULL);
+    REQUIRE(mk);
+    const uint8_t *w = NULL;
+    rs_error err = {0};
+    REQUIRE(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_LIPS, &w, &err) == RS_OK && w);
+    float edge = RS_MAKEUP_MASK_EDGE_MM / c->hdr.mm_per_unit;
+    // Along a row: 0 on the right half, rising with the distance to it on the left, 255 beyond the edge.
+    int bad = 0, last = 256;
+    float half_at = NAN;
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        float x = c->pos[i][0];
+        bool lips = x < -1e-6f;
+        if (!lips) bad += w[i] != 0;
+        else if (x < -edge - 1e-4f) bad += w[i] != 255;
+        else bad += w[i] == 0;  // inside and near the border: faded, never cut to nothing
+    }
+    RS_CHECK(bad == 0, "%d splats with the wrong weight", bad);
+    uint32_t row = 100 * 201;  // y = 0
+    for (uint32_t x = 0; x < 100; x++) {  // from the far left towards the border: non-increasing
+        int v = w[row + x];
+        RS_CHECK(v <= last, "weight rises again towards the border at column %u (%d after %d)", x, v, last);
+        if (v >= 128) half_at = -c->pos[row + x][0] * c->hdr.mm_per_unit;  // the last one still above half
+        last = v;
+    }
+    // smoothstep(d / edge) = 1/2 at d = edge / 2, d measured to the nearest splat outside (at x = 0).
+    float spacing_mm = 0.002f * c->hdr.mm_per_unit;
+    RS_CHECK(half_at >= 0.5f * RS_MAKEUP_MASK_EDGE_MM - 1e-3f && half_at <= 0.5f * RS_MAKEUP_MASK_EDGE_MM + spacing_mm,
+             "weight halves %.2f mm inside the border", half_at);
+    // The same table on demand; a table without an eyelid region has no eye mask (ignored), ANY none.
+    const uint8_t *again = NULL, *eyes = (const uint8_t *)1, *any = (const uint8_t *)1;
+    RS_CHECK(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_LIPS, &again, &err) == RS_OK && again == w, "rebuilt");
+    RS_CHECK(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_EYES, &eyes, &err) == RS_OK && eyes == NULL,
+             "eye mask on a face without eyelids");
+    RS_CHECK(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_ANY, &any, &err) == RS_OK && any == NULL, "any");
+    // Skin is everything but lips, eyelids and brows: here the right half.
+    const uint8_t *skin = NULL;
+    REQUIRE(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_SKIN, &skin, &err) == RS_OK && skin);
+    RS_CHECK(skin[row + 10] == 0 && skin[row + 190] == 255, "skin mask: %d left, %d right", skin[row + 10],
+             skin[row + 190]);
+    rs_makeup_destroy(mk);
+    rs_splat_destroy(c);
+}
+
+static void test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_masked(void)
+{
+    rs_splat_cloud *c = split_plane();
+    rs_makeup *mk = layer(c, NULL);
+    REQUIRE(mk);
+    // A lipstick dab centred on the border, kept to the lips and not.
+    for (int masked = 1; masked >= 0; masked--) {
+        rs_makeup_stamp_desc d = stamp_at(0.0f, 0.0f, 0.1f, "lipstick_matte");
+        d.region_mask = masked;
+        REQUIRE(stamp(mk, &d, NULL));
+        uint32_t left = 0, right = 0;
+        for (uint32_t i = 0; i < c->hdr.count; i++)
+            if (rs_makeup_records(mk)[i].colour_i || rs_makeup_records(mk)[i].spec_i)
+                *(c->pos[i][0] < 0 ? &left : &right) += 1;
+        if (masked) RS_CHECK(left > 100 && right == 0, "masked: %u painted on the lips, %u off them", left, right);
+        else RS_CHECK(right > 100, "unmasked: only %u painted off the lips", right);
+        RS_CHECK(rs_makeup_log_stamps(mk)[rs_makeup_log_count(mk) - 1].region_mask == masked, "log flag");
+        if (masked) REQUIRE(rs_makeup_undo(mk, NULL));
+    }
+    // The eraser is never kept to a region: it cleans up wherever it goes (bleed included).
+    rs_makeup_gpu *snap[2];
+    for (int masked = 1; masked >= 0; masked--) {
+        rs_makeup_stamp_desc e = stamp_at(0.0f, 0.0f, 0.1f, NULL);
+        e.region_mask = masked;
+        REQUIRE(stamp(mk, &e, NULL));
+        snap[masked] = snapshot(mk);
+        REQUIRE(rs_makeup_undo(mk, NULL));
+    }
+    RS_CHECK(memcmp(snap[0], snap[1], rs_makeup_count(mk) * sizeof *snap[0]) == 0, "a masked eraser erased less");
+    free(snap[0]);
+    free(snap[1]);
+    rs_makeup_destroy(mk);
+    rs_splat_destroy(c);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -833,5 +935,7 @@ int main(int argc, char **argv)
     RS_RUN(test_bad_stamps_are_refused_without_change);
     RS_RUN(test_take_dirty_gives_compact_ranges_per_lod_band);
     RS_RUN(test_overlapping_passes_build_up_without_banding);
+    RS_RUN(test_region_mask_is_zero_outside_and_rises_softly_inside);
+    RS_RUN(test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_masked);
     return rs_test_finish();
 }

@@ -687,10 +687,11 @@ static void test_region_map_and_property_label_samples(void)
 
 static void test_region_map_colour_codes(void)
 {
-    const uint8_t c[7][3] = {{0, 0, 0}, {250, 10, 5}, {0, 240, 20}, {10, 10, 250}, {250, 250, 10}, {255, 255, 255}, {240, 250, 245}};
-    const uint8_t want[7] = {RS_REGION_OTHER, RS_REGION_CHEEK, RS_REGION_NOSE, RS_REGION_FOREHEAD, RS_REGION_LIPS,
-                             RS_PACK_REGION_AUTO, RS_PACK_REGION_AUTO};
-    for (int i = 0; i < 7; i++)
+    const uint8_t c[9][3] = {{0, 0, 0},     {250, 10, 5},    {0, 240, 20},   {10, 10, 250}, {250, 250, 10},
+                             {250, 10, 240}, {10, 245, 250}, {255, 255, 255}, {240, 250, 245}};
+    const uint8_t want[9] = {RS_REGION_OTHER,  RS_REGION_CHEEK,     RS_REGION_NOSE,     RS_REGION_FOREHEAD, RS_REGION_LIPS,
+                             RS_REGION_EYELID, RS_REGION_BROW, RS_PACK_REGION_AUTO, RS_PACK_REGION_AUTO};
+    for (int i = 0; i < 9; i++)
         RS_CHECK(rs_pack_region_from_rgb(c[i]) == want[i], "colour %d -> %u", i, rs_pack_region_from_rgb(c[i]));
 }
 
@@ -951,12 +952,18 @@ static void test_bundled_face_regions_are_where_they_belong(void)
         {-0.49f, 0.39f, RS_REGION_LIPS, "mouth corner, subject's right"},
         {0.33f, 0.39f, RS_REGION_LIPS, "mouth corner, subject's left"},
         {-0.088f, 0.55f, RS_REGION_LIPS, "upper lip"},
-        {-0.088f, 0.32f, RS_REGION_LIPS, "lower lip"},
+        {-0.088f, 0.35f, RS_REGION_LIPS, "lower lip"},
         {-0.088f, 2.80f, RS_REGION_FOREHEAD, "forehead"},
         {-0.85f, 0.90f, RS_REGION_CHEEK, "right cheek"},
         {0.70f, 0.90f, RS_REGION_CHEEK, "left cheek"},
         {-0.088f, -0.20f, RS_REGION_OTHER, "chin"},
-        {-0.55f, 1.75f, RS_REGION_OTHER, "right eyelid"},
+        {-0.55f, 1.75f, RS_REGION_EYELID, "right eyelid"},
+        {0.38f, 1.75f, RS_REGION_EYELID, "left eyelid"},
+        {-0.30f, 1.64f, RS_REGION_EYELID, "right eye, inner corner"},
+        {-0.74f, 2.02f, RS_REGION_BROW, "right brow"},
+        {0.57f, 2.02f, RS_REGION_BROW, "left brow"},
+        {-0.088f, 2.12f, RS_REGION_OTHER, "between the brows (glabella)"},
+        {-0.74f, 2.41f, RS_REGION_FOREHEAD, "above the right brow"},
     };
     for (size_t k = 0; k < RS_COUNT_OF(probe); k++) {
         int i = front_splat(c, probe[k].x, probe[k].y);
@@ -976,11 +983,17 @@ static void test_bundled_face_regions_are_where_they_belong(void)
     }
     RS_CHECK(back_face == 0, "%u back-facing splats are not `other`", back_face);
     // Sizes: lips and nose are small, cheeks and forehead larger; everything else dominates.
-    double f[RS_REGION_BUILTIN_COUNT];
-    for (int r = 0; r < RS_REGION_BUILTIN_COUNT; r++) f[r] = (double)c->region_counts[r] / h->count;
+    double f[RS_REGION_STANDARD_COUNT];
+    RS_CHECK(h->region_count == RS_REGION_STANDARD_COUNT && strcmp(h->regions[RS_REGION_EYELID].name, "eyelid") == 0 &&
+                 strcmp(h->regions[RS_REGION_BROW].name, "brow") == 0,
+             "%u regions", h->region_count);
+    for (int r = 0; r < RS_REGION_STANDARD_COUNT; r++) f[r] = (double)c->region_counts[r] / h->count;
     RS_CHECK(f[RS_REGION_LIPS] > 0.002 && f[RS_REGION_LIPS] < f[RS_REGION_NOSE] && f[RS_REGION_NOSE] < f[RS_REGION_CHEEK] &&
-                 f[RS_REGION_FOREHEAD] > 0.01 && f[RS_REGION_OTHER] > 0.8,
-             "region fractions other %.3f cheek %.3f nose %.3f forehead %.3f lips %.3f", f[0], f[1], f[2], f[3], f[4]);
+                 f[RS_REGION_FOREHEAD] > 0.01 && f[RS_REGION_OTHER] > 0.8 && f[RS_REGION_EYELID] > 0.004 &&
+                 f[RS_REGION_BROW] > 0.003 && f[RS_REGION_BROW] < f[RS_REGION_EYELID] &&
+                 f[RS_REGION_EYELID] < f[RS_REGION_CHEEK],
+             "region fractions other %.3f cheek %.3f nose %.3f forehead %.3f lips %.3f eyelid %.3f brow %.3f", f[0], f[1],
+             f[2], f[3], f[4], f[5], f[6]);
     rs_splat_destroy(c);
 }
 

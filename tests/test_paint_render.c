@@ -476,6 +476,118 @@ static void test_forehead_stroke_lands_on_the_forehead_where_it_was_drawn(void)
         check_landing("forehead.strokes", "cosmetic powder", "cosmetic blush", RS_REGION_FOREHEAD, "forehead");
 }
 
+// ---- region-aware brushes (issue 15) ---------------------------------------------------------------
+
+// A lipstick stroke file: a vertical stroke down the middle of the mouth from the upper lip over the
+// lower lip's border onto the chin, and one along the lower lip's border past both mouth corners; the
+// brush keeps to the lips (mask=1) or not (mask=0).
+static rs_strokes *lip_line_strokes(bool masked)
+{
+    char text[8192];
+    int n = snprintf(text, sizeof text,
+                     "rouge-strokes 1\nview yaw=0 pitch=0 zoom=1 fov=30 size=256x256\n"
+                     "brush size=0.05 opacity=1 pressure=none mirror=0 eraser=0 mask=%d\ncosmetic lipstick_matte\n",
+                     masked);
+    const float path[2][4] = {{126, 176, 126, 216}, {96, 199, 160, 199}};
+    for (int k = 0; k < 2; k++) {
+        n += snprintf(text + n, sizeof text - (size_t)n, "stroke\n");
+        for (int i = 0; i <= 24; i++) {
+            float t = i / 24.0f;
+            n += snprintf(text + n, sizeof text - (size_t)n, "s %.4f %.2f %.2f 1\n", i / 60.0,
+                          path[k][0] + t * (path[k][2] - path[k][0]), path[k][1] + t * (path[k][3] - path[k][1]));
+        }
+        n += snprintf(text + n, sizeof text - (size_t)n, "end\n");
+    }
+    rs_strokes *doc = NULL;
+    rs_error err = {0};
+    RS_CHECK(rs_strokes_parse(text, (size_t)n, &doc, &err) == RS_OK, "lip strokes: %s", err.msg);
+    return doc;
+}
+
+// Pixels outside the lips in the `regions` view of the same camera: no pixel within 1 px shows any of
+// the lips' colour (region colours blend where splats of two regions overlap a pixel: a pixel with a
+// few percent of lips in it is not outside them), on the face.
+static uint8_t *outside_lips_mask(const rs_image *regions, int *count)
+{
+    uint8_t *lipsish = calloc(SIZE * SIZE, 1), *out = calloc(SIZE * SIZE, 1);
+    if (!lipsish || !out) {
+        free(lipsish), free(out);
+        return NULL;
+    }
+    // The lips' colour in the regions view is a saturated yellow (render_attribute.c's palette); a pixel
+    // with a part of it has red and green above its blue, which no neighbour of the lips (grey other, red
+    // cheek) has: 8 levels are ~5 % of lips.
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            const uint8_t *p = px(regions, x, y);
+            lipsish[y * SIZE + x] = p[0] > p[2] + 8 && p[1] > p[2] + 8;
+        }
+    const uint8_t *bg = px(regions, 0, 0);
+    *count = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            const uint8_t *p = px(regions, x, y);
+            bool background = p[0] == bg[0] && p[1] == bg[1] && p[2] == bg[2];
+            out[y * SIZE + x] = !background && !near_mask(lipsish, x, y, 1);
+            *count += out[y * SIZE + x];
+        }
+    free(lipsish);
+    return out;
+}
+
+// Issue 15's acceptance: a lipstick stroke crossing the lip line changes pixels outside the lips region
+// by at most 2/255 with the region mask on, and changes them clearly with it off.
+static void test_lipstick_kept_to_the_lips_changes_nothing_outside_them(void)
+{
+    if (!need_face()) return;
+    rs_image regions = {0}, bare = {0}, on = {0}, off = {0};
+    uint8_t *outside = NULL;
+    int n_out = 0;
+    if (!render_bare(RS_MODE_REGIONS, &regions) || !render_bare(RS_MODE_FULL, &bare)) goto done;
+    outside = outside_lips_mask(&regions, &n_out);
+    if (!RS_CHECK(outside && n_out > SIZE * SIZE / 8, "outside-lips mask: %d px", n_out)) goto done;
+    for (int masked = 1; masked >= 0; masked--) {
+        rs_makeup *mk = new_layer(face);
+        rs_strokes *doc = lip_line_strokes(masked);
+        bool ok = mk && doc && replay_doc(mk, doc) && render_mode(RS_MODE_FULL, masked ? &on : &off);
+        rs_strokes_destroy(doc);
+        rs_makeup_destroy(mk);
+        if (!ok) goto done;
+    }
+    int worst_on = 0, worst_off = 0, changed_off = 0, changed_on_lips = 0;
+    for (int y = 0; y < SIZE; y++)
+        for (int x = 0; x < SIZE; x++) {
+            int d_on = max_channel_diff(&on, &bare, x, y), d_off = max_channel_diff(&off, &bare, x, y);
+            if (outside[y * SIZE + x]) {
+                worst_on = RS_MAX(worst_on, d_on), worst_off = RS_MAX(worst_off, d_off);
+                changed_off += d_off > MASK_T;
+            } else {
+                changed_on_lips += d_on > MASK_T;
+            }
+        }
+    note("lip line: outside the lips (%d px) max change %d masked, %d unmasked (%d px over %d); %d px painted "
+         "on the lips",
+         n_out, worst_on, worst_off, changed_off, MASK_T, changed_on_lips);
+    bool ok = RS_CHECK(changed_on_lips > 100, "the masked stroke painted only %d px of the lips", changed_on_lips);
+    ok = ok && RS_CHECK(worst_on <= 2, "masked: a pixel outside the lips changed by %d/255", worst_on);
+    ok = ok && RS_CHECK(worst_off > 20 && changed_off > 100,
+                        "unmasked: outside the lips changed by at most %d/255 (%d px): the stroke does not cross "
+                        "the lip line",
+                        worst_off, changed_off);
+    if (!ok || getenv("RS_TEST_VERBOSE")) {
+        save_failure("lip_line_masked", &on, &bare);
+        save_failure("lip_line_unmasked", &off, &bare);
+        save_mask("lip_line_outside", outside);
+        rs_test_save("lip_line_regions", &regions);
+    }
+done:
+    free(outside);
+    rs_image_free(&regions);
+    rs_image_free(&bare);
+    rs_image_free(&on);
+    rs_image_free(&off);
+}
+
 // ---- brush size ----------------------------------------------------------------------------------------
 
 // One dab (a tap) at sizes 0.1, 0.2, 0.3 on the forehead. The brush falloff scales with the radius, so
@@ -1032,6 +1144,7 @@ int main(int argc, char **argv)
     RS_RUN(test_lip_stroke_lands_on_the_lips_where_it_was_drawn);
     RS_RUN(test_blush_stroke_lands_on_the_cheek_where_it_was_drawn);
     RS_RUN(test_forehead_stroke_lands_on_the_forehead_where_it_was_drawn);
+    RS_RUN(test_lipstick_kept_to_the_lips_changes_nothing_outside_them);
     RS_RUN(test_brush_sizes_grow_painted_area_quadratically);
     RS_RUN(test_foundation_shades_darken_only_the_painted_skin);
     RS_RUN(test_lip_gloss_raises_lip_specular_and_keeps_colour);

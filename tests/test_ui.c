@@ -350,7 +350,8 @@ static void render_toolbar(int w, int h, float scale, rs_image *out)
     rs_ui_toolbar_layout_compute(w, h, scale, 15, &l);
     rs_ui_toolbar_state st = {.swatch_count = 15, .swatch_rgb = golden_rgb, .swatch_name = golden_names,
                               .selected = 9, .size = 0.35f, .opacity = 0.7f, .light = {-0.45f, 0.4f},
-                              .paint = true, .mirror = true, .can_undo = true, .mode = 2, .mobile = true};
+                              .paint = true, .mirror = true, .keep_region = true, .region_name = "lips",
+                              .can_undo = true, .mode = 2, .mobile = true};
     rs_ui_begin(ui, w, h, scale, &(rs_ui_input){.x = -1, .y = -1});
     // A backdrop like the viewer's: a vertical grey gradient and a soft disc where the face would be.
     for (int i = 0; i < 16; i++) {

@@ -29,7 +29,7 @@ viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_o
 viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
 viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file
 viewer_streamed_face_draws_the_first_level_before_the_rest viewer_stdin_not_a_face_exits_with_one_line
-viewer_and_rouge_render_show_the_same_look"
+viewer_and_rouge_render_show_the_same_look viewer_region_brush_keeps_lipstick_on_the_lips"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -110,6 +110,7 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
         shots before
         echo "key p"          # paint mode
         echo "key 9"          # a strong colour (lipstick) so the change is unmistakable
+        echo "key k"          # ... on the forehead: the brush may leave the lips
         echo "drag 370 150 430 150 30"
         shots after
         echo "key ctrl+z"
@@ -162,6 +163,7 @@ if selected viewer_xdotool_stroke_changes_only_the_painted_area; then
             shots xbefore
             echo "key p"
             echo "key 9"
+            echo "key k"
             echo "wait-for $flag"
             shots xafter
             echo "quit"
@@ -369,6 +371,29 @@ if selected viewer_streamed_face_draws_the_first_level_before_the_rest; then
         fi
     fi
 fi
+if selected viewer_region_brush_keeps_lipstick_on_the_lips; then
+    # Lipstick stays on the lips by default: a stroke over the forehead paints nothing; with K (the brush
+    # may leave its region, also the rail's region button) the same stroke paints.
+    name=viewer_region_brush_keeps_lipstick_on_the_lips
+    {
+        echo "key i"
+        shots kbefore
+        echo "key p"
+        echo "key 9"
+        echo "drag 370 150 430 150 30"
+        shots kmasked
+        echo "key k"
+        echo "drag 370 150 430 150 30"
+        shots kfree
+        echo "quit"
+    } >"$out/region.events"
+    view --events "$out/region.events" >"$out/region.log" 2>&1
+    rc=$?
+    if [ $rc -ne 0 ] || [ ! -f "$out/kfree_mid.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/region.log")"
+    elif ! why=$(region_same kbefore kmasked in mid); then echo "FAIL - $name: lipstick painted the forehead: $why"
+    elif ! region_changed kmasked kfree; then echo "FAIL - $name: with K the stroke did not paint"
+    else echo "ok - $name"; fi
+fi
 if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
     # A stroke recording (--record) onto a full disk: the viewer says so and the old recording survives.
     name=viewer_recording_on_a_full_disk_keeps_the_old_file
@@ -376,7 +401,7 @@ if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
     if mount -t tmpfs -o size=64k tmpfs "$out/full" 2>/dev/null; then
         printf 'old recording' >"$out/full/rec.strokes"
         dd if=/dev/zero of="$out/full/filler" bs=1k count=64 >/dev/null 2>&1
-        printf 'key i\nkey p\nkey 9\nidle\ndrag 370 150 430 150 10\nidle\nquit\n' >"$out/full.events"
+        printf 'key i\nkey p\nkey 9\nkey k\nidle\ndrag 370 150 430 150 10\nidle\nquit\n' >"$out/full.events"
         view --record "$out/full/rec.strokes" --events "$out/full.events" >"$out/full.log" 2>&1
         rc=$?
         left=$(ls "$out/full" | grep -c '\.tmp\.')

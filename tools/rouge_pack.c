@@ -362,7 +362,7 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
     printf("%s\n", rep->regions_given ? " (some given by the input)" : "");
     if (o->maps[2]) {
         printf("  specular map  mean per region (not stored):");
-        for (uint32_t i = 0; i < RS_REGION_BUILTIN_COUNT; i++)
+        for (uint32_t i = 0; i < RS_REGION_STANDARD_COUNT; i++)
             if (!isnan(rep->specular_mean[i])) printf(" %s %.3f", c->hdr.regions[i].name, rep->specular_mean[i]);
         printf("\n");
     }

@@ -5,7 +5,7 @@
 //   cosmetic 0 lipstick_satin
 //   cosmetic 1 custom name=mine kind=custom rgb=200,80,120 weight=0.6 ...
 //   stroke
-//   p X Y Z VX VY VZ RADIUS AMOUNT COSMETIC     paint stamp
+//   p X Y Z VX VY VZ RADIUS AMOUNT COSMETIC [mask]  paint stamp (mask: kept to the cosmetic's region)
 //   e X Y Z VX VY VZ RADIUS AMOUNT              eraser stamp
 //   end
 //
@@ -65,18 +65,23 @@ static rs_result parse_stamp(parser *p, bool eraser, char **save)
     if (!(v[6] > 0.0f)) return perr(p, "stamp: radius: %g, must be > 0", v[6]);
     if (v[7] < 0.0f || v[7] > 1.0f) return perr(p, "stamp: amount: %g not in [0, 1]", v[7]);
     uint32_t cos = 0;
+    bool masked = false;
     if (!eraser) {
         char *tok = strtok_r(NULL, " \t", save);
         if (!tok) return perr(p, "stamp: missing cosmetic index");
         if (!rs_text_parse_uint(tok, UINT16_MAX, &cos) || cos >= lk->cosmetic_count)
             return perr(p, "stamp: cosmetic: '%.32s' is not a defined cosmetic index (0..%d)", tok,
                         (int)lk->cosmetic_count - 1);
+        char *flag = strtok_r(NULL, " \t", save);
+        if (flag && strcmp(flag, "mask") != 0)
+            return perr(p, "stamp: unexpected text '%.32s' after the cosmetic index (only 'mask' may follow)", flag);
+        masked = flag != NULL;
     }
     if (strtok_r(NULL, " \t", save)) return perr(p, "stamp: unexpected text after the last field");
     if (!rs_array_grow((void **)&lk->stamps, &p->stamp_cap, lk->stamp_count + 1, sizeof *lk->stamps))
         return rs_fail(p->err, RS_ERR_NOMEM, "line %u: out of memory", p->line);
     lk->stamps[lk->stamp_count++] = (rs_makeup_applied){{v[0], v[1], v[2]}, {v[3], v[4], v[5]}, v[6], v[7],
-                                                        (uint16_t)cos, eraser, p->stroke_empty};
+                                                        (uint16_t)cos, eraser, p->stroke_empty, masked};
     p->stroke_empty = false;
     return RS_OK;
 }
@@ -194,6 +199,7 @@ rs_result rs_look_apply(const rs_look *look, rs_makeup *mk, rs_makeup_range *dir
             .pressure_map = RS_MAKEUP_PRESSURE_NONE,
             .cosmetic = s->eraser ? NULL : &look->cosmetics[s->cosmetic],
             .eraser = s->eraser,
+            .region_mask = s->region_mask,
         };
         rs_result r = rs_makeup_stamp(mk, &d, NULL, err);
         if (r != RS_OK) {
@@ -254,7 +260,7 @@ rs_result rs_look_write_memory(const rs_makeup *mk, char **out, size_t *out_len,
         PUT("%c %.9g %.9g %.9g %.9g %.9g %.9g %.9g %.9g", s->eraser ? 'e' : 'p', s->pos[0], s->pos[1], s->pos[2],
             s->view_dir[0], s->view_dir[1], s->view_dir[2], s->radius, s->amount);
         if (s->eraser) PUT("\n");
-        else PUT(" %u\n", remap[s->cosmetic]);
+        else PUT(" %u%s\n", remap[s->cosmetic], s->region_mask ? " mask" : "");
     }
     if (n) PUT("end\n");
 #undef PUT

@@ -226,13 +226,13 @@ static rs_result parse_view(parser *p, char **save)
 
 static rs_result parse_brush(parser *p, char **save)
 {
-    static const char *const keys[] = {"size", "opacity", "pressure", "mirror", "eraser"};
-    bool seen[5] = {false};
+    static const char *const keys[] = {"size", "opacity", "pressure", "mirror", "eraser", "mask"};
+    bool seen[6] = {false};
     rs_strokes_brush b = {0};
     char *tok, *key, *val;
     while ((tok = strtok_r(NULL, " \t", save)) != NULL) {
         if (!split_kv(tok, &key, &val)) return perr(p, "brush: '%.64s' is not key=value", tok);
-        int k = key_index(key, keys, 5);
+        int k = key_index(key, keys, 6);
         if (k < 0) return perr(p, "brush: unknown key '%.32s'", key);
         if (seen[k]) return perr(p, "brush: %s given twice", key);
         seen[k] = true;
@@ -249,7 +249,8 @@ static rs_result parse_brush(parser *p, char **save)
         } else {
             ok = rs_text_parse_uint(val, 1, &flag);
             if (k == 3) b.mirror = flag;
-            else b.eraser = flag;
+            else if (k == 4) b.eraser = flag;
+            else b.any_region = !flag;
         }
         if (!ok) return perr(p, "brush: %s: bad value '%.64s'", key, val);
     }
@@ -380,9 +381,9 @@ rs_result rs_strokes_write_memory(const rs_strokes *doc, char **out, size_t *out
         }
         if (!prev || br->size_rel != prev->brush.size_rel || br->opacity != prev->brush.opacity ||
             br->pressure != prev->brush.pressure || br->mirror != prev->brush.mirror ||
-            br->eraser != prev->brush.eraser)
-            rs_text_printf(&b, "brush size=%.9g opacity=%.9g pressure=%s mirror=%d eraser=%d\n", br->size_rel, br->opacity,
-                      rs_strokes_pressure_name(br->pressure), br->mirror, br->eraser);
+            br->eraser != prev->brush.eraser || br->any_region != prev->brush.any_region)
+            rs_text_printf(&b, "brush size=%.9g opacity=%.9g pressure=%s mirror=%d eraser=%d mask=%d\n", br->size_rel,
+                      br->opacity, rs_strokes_pressure_name(br->pressure), br->mirror, br->eraser, !br->any_region);
         if (!prev || !rs_cosmetic_equal(&s->cosmetic, &prev->cosmetic)) {
             char c[512];
             rs_cosmetic_format(&s->cosmetic, c, sizeof c);

@@ -40,6 +40,7 @@ typedef struct rs_strokes_brush {
     float opacity;                  // 0..1
     rs_makeup_pressure pressure;    // file: pressure=floor|linear|none
     bool mirror, eraser;
+    bool any_region;                // file: mask=0 (paint anywhere); mask=1 or absent: keep to the product's region
 } rs_strokes_brush;
 
 typedef struct rs_strokes_sample {

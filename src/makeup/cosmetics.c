@@ -20,57 +20,58 @@
 #include <string.h>
 
 //  name, kind, sRGB, I_M, colour w, finish w, m, rho_s, size (diameter / face height), opacity, coat, shimmer,
-//  coverage
+//  coverage, region (where the brush stays unless told otherwise: lips, the eye area, or skin off the lips,
+//  eyes and brows)
 static const rs_cosmetic presets[] = {
     // Foundation shades 1 (light) to 3 (deep), a warm-neutral undertone like most skin. Satin-matte:
     // a little rougher and less specular than skin (the paper: base makeup reduces oily shine).
     // Large blending brush (0.3 = the paper's largest tool), medium coverage.
     {"foundation_1", RS_COSMETIC_FOUNDATION, {236, 203, 178}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     {"foundation_2", RS_COSMETIC_FOUNDATION, {208, 164, 132}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     {"foundation_3", RS_COSMETIC_FOUNDATION, {168, 122, 92}, 0.60f, 1.00f, 0.70f, 0.34f, 0.15f, 0.30f, 0.50f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     // Translucent setting powder: barely tints (colour weight 0.15, a slight brightening), fully matte:
     // roughness up, rho_s to about a third of skin. This is the "reduced shine" of the paper's Fig. 12.
     {"powder", RS_COSMETIC_POWDER, {236, 218, 204}, 0.50f, 0.15f, 1.00f, 0.45f, 0.07f, 0.30f, 0.60f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     // Powder blush, rose: sheer (low I_M, opacity 0.35) so it builds up over strokes; matte-ish finish
     // at half weight (a powder over skin, not a full film).
     {"blush", RS_COSMETIC_BLUSH, {220, 112, 122}, 0.35f, 1.00f, 0.50f, 0.35f, 0.14f, 0.20f, 0.35f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     // Bronzer: warm brown, sheer, matte; contour: cooler, greyer brown that reads as shadow.
     {"bronzer", RS_COSMETIC_BRONZER, {168, 110, 76}, 0.35f, 1.00f, 0.50f, 0.36f, 0.13f, 0.20f, 0.30f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     {"contour", RS_COSMETIC_BRONZER, {132, 100, 84}, 0.35f, 1.00f, 0.50f, 0.36f, 0.13f, 0.15f, 0.30f,
-     0.0f, 0.0f, 0.0f},
+     0.0f, 0.0f, 0.0f, RS_COSMETIC_REGION_SKIN},
     // Highlighter, shimmer: pale champagne at half colour weight (a sheen, not white paint); smoother
     // and brighter specular (rho_s 0.45, ~1.5-2x skin) is what makes it catch the light.
     {"highlighter", RS_COSMETIC_HIGHLIGHTER, {250, 236, 214}, 0.40f, 0.50f, 1.00f, 0.21f, 0.45f, 0.12f, 0.50f,
-     0.0f, 0.80f, 0.0f},
+     0.0f, 0.80f, 0.0f, RS_COSMETIC_REGION_SKIN},
     // Lipsticks: opaque, small brush. Matte red: rough, low specular. Satin pink: about the lips' own
     // measured finish (m 0.27-0.30, rho_s 0.26-0.31), so colour changes but the sheen stays.
     // Lipsticks are the most opaque products: full coverage and high pigment load, so two passes cover
     // the lips (I ~ 0.94 at the brush centre) while the lips' texture still shows through.
     {"lipstick_matte", RS_COSMETIC_LIPSTICK, {168, 36, 54}, 0.95f, 1.00f, 1.00f, 0.42f, 0.09f, 0.08f, 1.00f,
-     0.0f, 0.0f, 0.60f},
+     0.0f, 0.0f, 0.60f, RS_COSMETIC_REGION_LIPS},
     {"lipstick_satin", RS_COSMETIC_LIPSTICK, {204, 78, 118}, 0.90f, 1.00f, 1.00f, 0.27f, 0.28f, 0.08f, 1.00f,
-     0.25f, 0.0f, 0.40f},
+     0.25f, 0.0f, 0.40f, RS_COSMETIC_REGION_LIPS},
     // Lip gloss: colourless (colour weight 0: the record's colour intensity stays 0), a clear wet coat:
     // a full clear-coat lobe (the sharp window/softbox reflections) over a smoother lip lobe.
     {"lip_gloss", RS_COSMETIC_LIP_GLOSS, {255, 255, 255}, 0.60f, 0.00f, 1.00f, 0.12f, 0.65f, 0.08f, 0.80f,
-     1.00f, 0.0f, 0.0f},
+     1.00f, 0.0f, 0.0f, RS_COSMETIC_REGION_LIPS},
     // Eyeshadows: brown matte (the paper's Fig. 12), plum satin, champagne shimmer. Lid-sized brush.
     {"eyeshadow_brown", RS_COSMETIC_EYESHADOW, {122, 82, 62}, 0.55f, 1.00f, 0.80f, 0.38f, 0.12f, 0.07f, 0.60f,
-     0.0f, 0.0f, 0.30f},
+     0.0f, 0.0f, 0.30f, RS_COSMETIC_REGION_EYES},
     {"eyeshadow_plum", RS_COSMETIC_EYESHADOW, {112, 62, 92}, 0.55f, 1.00f, 0.80f, 0.30f, 0.20f, 0.07f, 0.60f,
-     0.0f, 0.0f, 0.50f},
+     0.0f, 0.0f, 0.50f, RS_COSMETIC_REGION_EYES},
     {"eyeshadow_champagne", RS_COSMETIC_EYESHADOW, {222, 192, 152}, 0.55f, 0.80f, 1.00f, 0.22f, 0.40f, 0.07f, 0.60f,
-     0.0f, 0.60f, 0.0f},
+     0.0f, 0.60f, 0.0f, RS_COSMETIC_REGION_EYES},
     // Eyeliner: near-black, opaque (coverage 1: its black is not lifted to the face's darkest colour),
     // fine hard line; a matte gel liner (a glossy one mirrors the softboxes as a grey streak along it).
     {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.38f, 0.10f, 0.02f, 1.00f,
-     0.0f, 0.0f, 1.00f},
+     0.0f, 0.0f, 1.00f, RS_COSMETIC_REGION_EYES},
 };
 
 uint32_t rs_cosmetic_count(void) { return (uint32_t)RS_COUNT_OF(presets); }
@@ -95,6 +96,37 @@ const char *rs_cosmetic_kind_name(rs_cosmetic_kind kind)
 }
 
 static float clamp01(float x) { return isfinite(x) ? RS_CLAMP(x, 0.0f, 1.0f) : 0.0f; }
+
+rs_cosmetic_region rs_cosmetic_region_of(const rs_cosmetic *c)
+{
+    if (c->region_mask != RS_COSMETIC_REGION_DEFAULT && (unsigned)c->region_mask < RS_COSMETIC_REGION_COUNT)
+        return c->region_mask;
+    switch (c->kind) {
+    case RS_COSMETIC_LIPSTICK:
+    case RS_COSMETIC_LIP_GLOSS: return RS_COSMETIC_REGION_LIPS;
+    case RS_COSMETIC_EYESHADOW:
+    case RS_COSMETIC_EYELINER: return RS_COSMETIC_REGION_EYES;
+    case RS_COSMETIC_CUSTOM: return RS_COSMETIC_REGION_ANY;
+    default: return RS_COSMETIC_REGION_SKIN;  // base, powder, blush, bronzer, highlighter
+    }
+}
+
+const char *rs_cosmetic_region_name(rs_cosmetic_region r)
+{
+    static const char *names[RS_COSMETIC_REGION_COUNT] = {"default", "any", "lips", "eyes", "skin"};
+    return (unsigned)r < RS_COSMETIC_REGION_COUNT ? names[r] : "unknown";
+}
+
+bool rs_cosmetic_region_allows(rs_cosmetic_region r, const char *region)
+{
+    switch (r) {
+    case RS_COSMETIC_REGION_LIPS: return strcmp(region, "lips") == 0;
+    case RS_COSMETIC_REGION_EYES: return strcmp(region, "eyelid") == 0;
+    case RS_COSMETIC_REGION_SKIN:
+        return strcmp(region, "lips") != 0 && strcmp(region, "eyelid") != 0 && strcmp(region, "brow") != 0;
+    default: return true;
+    }
+}
 
 // The finish families as (m, rho_s, coat, shimmer): matte and satin from the anchors above; gloss adds a
 // full clear coat to a smooth lobe; shimmer a smooth, bright lobe with flakes.
@@ -146,7 +178,8 @@ rs_cosmetic rs_cosmetic_custom(const uint8_t rgb[3], float material_weight, floa
 {
     // Defaults of a medium blending brush; colour and finish at full weight.
     rs_cosmetic c = {"custom", RS_COSMETIC_CUSTOM, {rgb[0], rgb[1], rgb[2]}, clamp01(material_weight),
-                     1.0f, 1.0f, clamp01(m), clamp01(rho_s), 0.15f, 0.6f, 0.0f, 0.0f, 0.0f};
+                     1.0f, 1.0f, clamp01(m), clamp01(rho_s), 0.15f, 0.6f, 0.0f, 0.0f, 0.0f,
+                     RS_COSMETIC_REGION_DEFAULT};
     return c;
 }
 
@@ -195,6 +228,8 @@ rs_result rs_cosmetic_validate(const rs_cosmetic *c, rs_error *err)
                            f[i].v);
     if (!isfinite(c->size_rel) || !(c->size_rel > 0.0f) || c->size_rel > 1.0f)
         return rs_fail(err, RS_ERR_FORMAT, "cosmetic %s: size: %g, must be in (0, 1]", c->name, c->size_rel);
+    if ((unsigned)c->region_mask >= RS_COSMETIC_REGION_COUNT)
+        return rs_fail(err, RS_ERR_FORMAT, "cosmetic %s: region %d unknown", c->name, (int)c->region_mask);
     return RS_OK;
 }
 
@@ -204,7 +239,8 @@ bool rs_cosmetic_equal(const rs_cosmetic *a, const rs_cosmetic *b)
            a->rgb[1] == b->rgb[1] && a->rgb[2] == b->rgb[2] && a->material_weight == b->material_weight &&
            a->colour_weight == b->colour_weight && a->finish_weight == b->finish_weight && a->m == b->m &&
            a->rho_s == b->rho_s && a->size_rel == b->size_rel && a->opacity == b->opacity && a->coat == b->coat &&
-           a->shimmer == b->shimmer && a->coverage == b->coverage;
+           a->shimmer == b->shimmer && a->coverage == b->coverage &&
+           rs_cosmetic_region_of(a) == rs_cosmetic_region_of(b);
 }
 
 // --- text form ---------------------------------------------------------------------------------------
@@ -213,9 +249,16 @@ int rs_cosmetic_format(const rs_cosmetic *c, char *buf, size_t cap)
 {
     const rs_cosmetic *preset = rs_cosmetic_find(c->name);
     if (preset && rs_cosmetic_equal(preset, c)) return snprintf(buf, cap, "%s", c->name);
-    char finish[96] = "";
+    char finish[128] = "";
     if (c->coat != 0.0f || c->shimmer != 0.0f || c->coverage != 0.0f)
         snprintf(finish, sizeof finish, " coat=%.9g shimmer=%.9g coverage=%.9g", c->coat, c->shimmer, c->coverage);
+    rs_cosmetic kind_default = *c;
+    kind_default.region_mask = RS_COSMETIC_REGION_DEFAULT;
+    rs_cosmetic_region region = rs_cosmetic_region_of(c);
+    if (region != rs_cosmetic_region_of(&kind_default)) {
+        size_t n = strlen(finish);
+        snprintf(finish + n, sizeof finish - n, " region=%s", rs_cosmetic_region_name(region));
+    }
     return snprintf(buf, cap,
                     "custom name=%.*s kind=%s rgb=%u,%u,%u weight=%.9g colour=%.9g finish=%.9g m=%.9g rho_s=%.9g "
                     "size=%.9g opacity=%.9g%s",
@@ -273,6 +316,11 @@ rs_result rs_cosmetic_parse(const char *text, rs_cosmetic *out, rs_error *err)
             for (int k = 0; k < RS_COSMETIC_KIND_COUNT; k++)
                 if (strcmp(val, rs_cosmetic_kind_name((rs_cosmetic_kind)k)) == 0)
                     c.kind = (rs_cosmetic_kind)k, ok = true;
+        } else if (strcmp(key, "region") == 0) {
+            ok = false;
+            for (int k = RS_COSMETIC_REGION_ANY; k < RS_COSMETIC_REGION_COUNT; k++)
+                if (strcmp(val, rs_cosmetic_region_name((rs_cosmetic_region)k)) == 0)
+                    c.region_mask = (rs_cosmetic_region)k, ok = true;
         } else if (strcmp(key, "rgb") == 0) {
             ok = parse_f3(val, f3);
             for (int k = 0; ok && k < 3; k++) {

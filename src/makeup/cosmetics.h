@@ -34,6 +34,17 @@ typedef enum rs_cosmetic_kind {
     RS_COSMETIC_KIND_COUNT,
 } rs_cosmetic_kind;
 
+// Where a product goes by default when its brush keeps to regions (region-aware brushes, issue 15;
+// regions are the .rsf region table's, found by name: see rs_cosmetic_region_allows).
+typedef enum rs_cosmetic_region {
+    RS_COSMETIC_REGION_DEFAULT = 0,  // the kind's: lipstick/gloss lips, liner/shadow eyes, custom any, else skin
+    RS_COSMETIC_REGION_ANY,          // anywhere
+    RS_COSMETIC_REGION_LIPS,         // "lips"
+    RS_COSMETIC_REGION_EYES,         // "eyelid": the eye area from the lash lines to the brows
+    RS_COSMETIC_REGION_SKIN,         // everything but "lips", "eyelid" and "brow"
+    RS_COSMETIC_REGION_COUNT,
+} rs_cosmetic_region;
+
 // One product. Colour weights and intensities are 0..1. `m` and `rho_s` are absolute targets in the
 // specular model's units (Beckmann roughness, Kelemen/Szirmay-Kalos scale; skin is about 0.23-0.30 and
 // 0.18-0.31): where the product lies with finish intensity 1 they replace the skin's values.
@@ -54,6 +65,7 @@ typedef struct rs_cosmetic {
     float coverage;          // 0 sheer .. 1 opaque: an opaque pigment keeps its own colour (not held in the
                              // face's range), hides the skin texture and deposits fully in one stroke (eq. 3
                              // moves towards the brush footprint alone); docs/makeup.md
+    rs_cosmetic_region region_mask;  // where its brush stays unless told otherwise (0 = the kind's default)
 } rs_cosmetic;
 
 // Finish families (docs/makeup.md): what a product editor offers. Each sets m, rho_s, coat, shimmer.
@@ -77,6 +89,12 @@ const rs_cosmetic *rs_cosmetic_get(uint32_t i);
 const rs_cosmetic *rs_cosmetic_find(const char *name);
 const char *rs_cosmetic_kind_name(rs_cosmetic_kind kind);
 
+// The region a product keeps to, DEFAULT resolved by kind (never DEFAULT); its name ("lips", "eyes",
+// "skin", "any") for files and the UI; and whether a region of the face table named `region` is in it.
+rs_cosmetic_region rs_cosmetic_region_of(const rs_cosmetic *c);
+const char *rs_cosmetic_region_name(rs_cosmetic_region r);
+bool rs_cosmetic_region_allows(rs_cosmetic_region r, const char *region);
+
 // A custom product: colour from sRGB, finish (m, rho_s) and weights given; named "custom", default
 // brush of a medium blending brush. Values are clamped to their ranges.
 rs_cosmetic rs_cosmetic_custom(const uint8_t rgb[3], float material_weight, float m, float rho_s);
@@ -90,7 +108,8 @@ bool rs_cosmetic_equal(const rs_cosmetic *a, const rs_cosmetic *b);
 
 // Text form used by stroke and look files (docs/makeup.md): a preset's name when c equals that preset,
 // else "custom name=N kind=K rgb=R,G,B weight=W colour=C finish=F m=M rho_s=S size=Z opacity=O
-// coat=G shimmer=H coverage=V" (the last three only when non-zero)
+// coat=G shimmer=H coverage=V region=R" (the finish layers only when non-zero, the region only when not the
+// kind's default)
 // (floats printed to round-trip exactly). Returns what snprintf returns.
 int rs_cosmetic_format(const rs_cosmetic *c, char *buf, size_t cap);
 // Parses that form (NUL-terminated, one line). "custom" needs rgb= or hsv=H,S,V plus m= and rho_s=;

@@ -126,6 +126,10 @@ struct rs_makeup {
     uint32_t stamp_count, stamp_cap;
     rs_cosmetic *cosmetics;
     uint32_t cosmetic_count, cosmetic_cap;
+
+    // Region masks by rs_cosmetic_region, built on first use (rs_makeup_region_weights).
+    uint8_t *mask[RS_COSMETIC_REGION_COUNT];
+    bool mask_built[RS_COSMETIC_REGION_COUNT];
 };
 
 // --- arithmetic ------------------------------------------------------------------------------------
@@ -513,6 +517,97 @@ static void build_range(rs_makeup *mk, const float lut[256])
     }
 }
 
+// --- region masks -----------------------------------------------------------------------------------
+
+static uint32_t splat_region(const rs_makeup *mk, uint32_t i) { return mk->cloud->packed[i].w[1] >> 24; }
+
+rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err)
+{
+    *out = NULL;
+    if ((unsigned)region >= RS_COSMETIC_REGION_COUNT || region == RS_COSMETIC_REGION_ANY ||
+        region == RS_COSMETIC_REGION_DEFAULT)
+        return RS_OK;
+    if (mk->mask_built[region]) {
+        *out = mk->mask[region];
+        return RS_OK;
+    }
+    const rs_splat_header *h = &mk->cloud->hdr;
+    bool allowed[256] = {false};
+    for (uint32_t k = 0; k < h->region_count && k < RS_SPLAT_MAX_REGIONS; k++) {
+        char name[sizeof h->regions[k].name + 1] = {0};
+        memcpy(name, h->regions[k].name, sizeof h->regions[k].name);
+        allowed[k] = rs_cosmetic_region_allows(region, name);
+    }
+    uint8_t *w = malloc(RS_MAX(mk->n, 1u));
+    uint8_t *cell_out = calloc(RS_MAX(mk->cell_count, 1u), 1);  // the cell holds a splat outside the mask
+    if (!w || !cell_out) {
+        free(w);
+        free(cell_out);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: region mask: out of memory");
+    }
+    uint32_t inside = 0;
+    for (uint32_t c = 0; c < mk->cell_count; c++) {
+        const grid_cell *gc = &mk->cells[c];
+        for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
+            uint32_t i = mk->order[k];
+            w[i] = allowed[splat_region(mk, i)] ? 255 : 0;
+            inside += w[i] != 0;
+            cell_out[c] |= w[i] == 0;
+        }
+    }
+    mk->mask_built[region] = true;
+    if (inside == 0) {  // nothing of this face is in the mask: ignore it rather than paint nothing
+        free(w);
+        free(cell_out);
+        return RS_OK;
+    }
+    // Soft edge: each splat inside takes smoothstep(d / edge), d the distance to the nearest splat
+    // outside; only cells within `reach` cells of one holding a splat outside need looking at.
+    float edge = RS_MAKEUP_MASK_EDGE_MM / (h->mm_per_unit > 0.0f ? h->mm_per_unit : 1.0f);
+    float e2 = edge * edge;
+    int reach = (int)ceilf(edge * mk->inv_cell);
+    reach = RS_CLAMP(reach, 1, 4);
+    for (uint32_t c = 0; c < mk->cell_count; c++) {
+        const grid_cell *gc = &mk->cells[c];
+        int cx = (int)(gc->key & 1023u), cy = (int)(gc->key >> 10 & 1023u), cz = (int)(gc->key >> 20 & 1023u);
+        // The neighbour cells holding splats outside, found once per cell (most cells have none).
+        const grid_cell *near[9 * 9 * 9];
+        int nn = 0;
+        for (int dz = -reach; dz <= reach; dz++)
+            for (int dy = -reach; dy <= reach; dy++)
+                for (int dx = -reach; dx <= reach; dx++) {
+                    int x = cx + dx, y = cy + dy, z = cz + dz;
+                    if (x < 0 || y < 0 || z < 0 || (uint32_t)x >= mk->dim[0] || (uint32_t)y >= mk->dim[1] ||
+                        (uint32_t)z >= mk->dim[2])
+                        continue;
+                    const grid_cell *nc = find_cell(mk, cell_key((uint32_t)x, (uint32_t)y, (uint32_t)z));
+                    if (nc && cell_out[nc - mk->cells]) near[nn++] = nc;
+                }
+        for (uint32_t k = gc->start; nn && k < gc->start + gc->count; k++) {
+            uint32_t i = mk->order[k];
+            if (!w[i]) continue;
+            const float *p = mk->cloud->pos[i];
+            float d2 = e2;
+            for (int q = 0; q < nn; q++)
+                for (uint32_t m = near[q]->start; m < near[q]->start + near[q]->count; m++) {
+                    uint32_t j = mk->order[m];
+                    if (allowed[splat_region(mk, j)]) continue;
+                    const float *o = mk->cloud->pos[j];
+                    float ex = o[0] - p[0], ey = o[1] - p[1], ez = o[2] - p[2];
+                    d2 = RS_MIN(d2, ex * ex + ey * ey + ez * ez);
+                }
+            if (d2 < e2) {
+                float t = sqrtf(d2 / e2);
+                w[i] = (uint8_t)RS_MAX(1, lrintf(255.0f * t * t * (3.0f - 2.0f * t)));
+            }
+        }
+    }
+    free(cell_out);
+    mk->mask[region] = w;
+    *out = w;
+    return RS_OK;
+}
+
 rs_result rs_makeup_create(const rs_splat_cloud *cloud, const rs_makeup_desc *desc, rs_makeup **out,
                            rs_error *err)
 {
@@ -572,6 +667,7 @@ void rs_makeup_destroy(rs_makeup *mk)
     free(mk->strokes);
     free(mk->stamps);
     free(mk->cosmetics);
+    for (int k = 0; k < RS_COSMETIC_REGION_COUNT; k++) free(mk->mask[k]);
     free(mk);
 }
 
@@ -685,6 +781,7 @@ typedef struct stamp_ctx {
     float facing_min;  // RS_MAKEUP_FACING_MIN * |view|: no normalising, so replays see the same bits
     float r2, inv_r2, amount;
     const prepared *cos;  // NULL = eraser
+    const uint8_t *mask;  // region mask weights (q/255), NULL = none
     rs_makeup_stamp_info *info;
 } stamp_ctx;
 
@@ -701,6 +798,7 @@ static void stamp_splat(stamp_ctx *x, uint32_t i)
         if (!(nrm[0] * x->view[0] + nrm[1] * x->view[1] + nrm[2] * x->view[2] > x->facing_min)) return;
     }
     float ig = falloff_t(d2 * x->inv_r2);
+    if (x->mask) ig *= x->mask[i] * (1.0f / 255.0f);  // outside the product's region: 0, soft at its edge
     if (!(ig > 0.0f)) return;
     x->info->touched++;
     int32_t s = mk->slot_of[i];
@@ -761,7 +859,7 @@ static int log_cosmetic(rs_makeup *mk, const rs_cosmetic *c)
 static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
 static void apply_stamp(rs_makeup *mk, const rs_makeup_applied *s, const rs_cosmetic *cosmetic,
-                        rs_makeup_stamp_info *info)
+                        const uint8_t *mask, rs_makeup_stamp_info *info)
 {
     prepared prep;
     const prepared *cos = NULL;
@@ -772,7 +870,7 @@ static void apply_stamp(rs_makeup *mk, const rs_makeup_applied *s, const rs_cosm
     const float *v = s->view_dir;
     float vlen = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     stamp_ctx x = {mk, s->pos, v, vlen > 0.0f, RS_MAKEUP_FACING_MIN * vlen, s->radius * s->radius,
-                   1.0f / (s->radius * s->radius), s->amount, cos, info};
+                   1.0f / (s->radius * s->radius), s->amount, cos, mask, info};
     for_cells(mk, s->pos, s->radius, stamp_cell, &x, &info->cells);
     mk->stamps[mk->stamp_count++] = *s;
 }
@@ -808,6 +906,11 @@ rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeu
         if (rs_cosmetic_validate(d->cosmetic, &cerr) != RS_OK)
             return rs_fail(err, RS_ERR_ARG, "makeup stamp: %s", cerr.msg);
     }
+    const uint8_t *mask = NULL;
+    if (d->region_mask && !d->eraser) {
+        rs_result r = rs_makeup_region_weights(mk, rs_cosmetic_region_of(d->cosmetic), &mask, err);
+        if (r != RS_OK) return r;
+    }
     bool implicit = !mk->in_stroke;
     if (implicit) rs_makeup_begin_stroke(mk);
 
@@ -839,19 +942,21 @@ rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeu
     mk->stroke_reserved = true;
 
     const rs_cosmetic *cos = d->eraser ? NULL : &mk->cosmetics[cos_index];
+    bool masked = d->region_mask && !d->eraser;
     rs_makeup_applied s = {{d->pos[0], d->pos[1], d->pos[2]},
                            {d->view_dir[0], d->view_dir[1], d->view_dir[2]},
                            d->radius,
                            clamp01(d->opacity) * rs_makeup_pressure_scale(d->pressure_map, d->pressure),
                            (uint16_t)cos_index,
                            d->eraser,
-                           mk->stamp_count == mk->stroke_first_stamp};
-    apply_stamp(mk, &s, cos, info);
+                           mk->stamp_count == mk->stroke_first_stamp,
+                           masked};
+    apply_stamp(mk, &s, cos, mask, info);
     if (mirror_idx != UINT32_MAX) {
         memcpy(s.pos, mk->cloud->pos[mirror_idx], sizeof s.pos);
         rs_makeup_mirror_dir(&mk->cloud->hdr, d->view_dir, s.view_dir);
         s.stroke_start = 0;
-        apply_stamp(mk, &s, cos, info);
+        apply_stamp(mk, &s, cos, mask, info);
         info->mirrored = true;
     }
     if (implicit) return rs_makeup_end_stroke(mk, err);

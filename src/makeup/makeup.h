@@ -65,6 +65,7 @@ typedef enum rs_makeup_pressure {
 #define RS_MAKEUP_FACING_MIN 0.2f   // facing test: dot(normal, view_dir) must exceed this
 #define RS_MAKEUP_TOUCH_K 1.0f      // I_F = 1 - exp(-touches / K), touches = strokes that reached the splat
 #define RS_MAKEUP_SIGMA_REL 0.5f    // I_G Gaussian sigma = 0.5 * brush radius (shifted to reach 0 at the rim)
+#define RS_MAKEUP_MASK_EDGE_MM 1.5f // region masks fade in over this distance inside the region's border
 
 typedef struct rs_makeup_desc {
     uint32_t undo_levels;  // strokes kept for undo/redo; 0 = 64
@@ -81,6 +82,8 @@ typedef struct rs_makeup_stamp_desc {
     const rs_cosmetic *cosmetic;      // required unless eraser
     bool eraser;                      // lower I towards 0 (colour and finish); 0 leaves the base exactly
     bool mirror;                      // also stamp the mirror image across the face mid-plane
+    bool region_mask;                 // keep to the cosmetic's region (rs_cosmetic_region_of), soft-edged;
+                                      // ignored for the eraser and where the face has no such region
 } rs_makeup_stamp_desc;
 
 typedef struct rs_makeup_stamp_info {
@@ -99,6 +102,7 @@ typedef struct rs_makeup_applied {
     uint16_t cosmetic;      // index into rs_makeup_log_cosmetic; unused for the eraser
     uint8_t eraser;
     uint8_t stroke_start;   // 1 on the first stamp of each stroke
+    uint8_t region_mask;    // 1: kept to its cosmetic's region (rs_makeup_stamp_desc.region_mask)
 } rs_makeup_applied;
 
 typedef struct rs_makeup rs_makeup;
@@ -152,6 +156,13 @@ uint32_t rs_makeup_log_count(const rs_makeup *mk);
 const rs_makeup_applied *rs_makeup_log_stamps(const rs_makeup *mk);
 uint32_t rs_makeup_log_cosmetic_count(const rs_makeup *mk);
 const rs_cosmetic *rs_makeup_log_cosmetic(const rs_makeup *mk, uint32_t i);
+
+// Per-splat weights (q/255) of a region mask, built on first use and kept: 0 outside the regions the
+// mask allows, rising as a smoothstep to 255 over RS_MAKEUP_MASK_EDGE_MM from the nearest splat
+// outside (measured in 3D), so products fade in at a region's border instead of stopping at a hard
+// line. *out = NULL when no splat of this face is in the mask (a file without eyelids: the mask is
+// then ignored) or for RS_COSMETIC_REGION_ANY. Fails only on out-of-memory.
+rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err);
 
 // Splat nearest to pos within max_dist (model units), through the grid; false when none.
 bool rs_makeup_nearest(const rs_makeup *mk, const float pos[3], float max_dist, uint32_t *idx);

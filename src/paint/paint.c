@@ -119,6 +119,7 @@ static rs_result stamp_at(rs_paint *p, const rs_input_stamp *s, rs_paint_result 
         .cosmetic = &b->cosmetic,
         .eraser = b->eraser,
         .mirror = b->mirror,
+        .region_mask = !b->any_region,
     };
     if (p->picker.view_dir) p->picker.view_dir(p->picker.user, pos, d.view_dir);
     rs_makeup_stamp_info info;
@@ -163,7 +164,7 @@ rs_result rs_paint_feed(rs_paint *p, const rs_input_event *ev, rs_paint_result *
         rs_makeup_begin_stroke(p->mk);
         if (p->rec) {
             rs_strokes_brush sb = {p->stroke_brush.size_rel, p->stroke_brush.opacity, p->stroke_brush.pressure,
-                                   p->stroke_brush.mirror, p->stroke_brush.eraser};
+                                   p->stroke_brush.mirror, p->stroke_brush.eraser, p->stroke_brush.any_region};
             p->rec_open = rs_strokes_begin(p->rec, &p->rec_view, &sb, &p->stroke_brush.cosmetic, NULL) == RS_OK;
             p->rec_pointer = ev->pointer_id;
             p->rec_t0 = ev->time_s;
@@ -208,8 +209,8 @@ rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, u
     rs_input_mode saved_mode = p->input.desc.mode;
     rs_strokes *saved_rec = p->rec;
     p->rec = NULL;  // a replay is not something the person did
-    p->brush = (rs_paint_brush){st->cosmetic, st->brush.size_rel, st->brush.opacity, st->brush.pressure,
-                                st->brush.eraser, st->brush.mirror};
+    p->brush = (rs_paint_brush){st->cosmetic,        st->brush.size_rel, st->brush.opacity, st->brush.pressure,
+                                st->brush.eraser,    st->brush.mirror,   st->brush.any_region};
     rs_input_set_mode(&p->input, RS_INPUT_PAINT);
     double q = rs_paint_radius(p) / rs_makeup_cloud(p->mk)->hdr.face_height;
     float sx = (float)frame_w_px / (float)st->view.width_px, sy = (float)frame_h_px / (float)st->view.height_px;

@@ -40,6 +40,7 @@ typedef struct rs_paint_brush {
     float opacity;                // 0..1; 0 = the cosmetic's default
     rs_makeup_pressure pressure;  // how pressure scales opacity
     bool eraser, mirror;
+    bool any_region;              // paint anywhere; default: keep to the cosmetic's region (soft-edged)
 } rs_paint_brush;
 
 typedef struct rs_paint_desc {

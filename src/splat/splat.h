@@ -23,14 +23,18 @@
 #define RS_SPLAT_MAX_COUNT (64u << 20)  // 64M splats: far above any face scan, keeps sizes in 32 bits
 #define RS_SPLAT_FLAG_AO (1u << 0)      // header flag: byte 15 of every record is its ambient occlusion
 
-// Built-in region ids (the region table may add more after these).
+// Built-in region ids. Every file carries the first five (rs_splat_default_regions); rouge-pack adds
+// eyelid and brow; a table may add more after these. Brushes find regions by name.
 typedef enum rs_region {
-    RS_REGION_OTHER = 0,  // other skin (ears, neck, scalp, eyelids, chin...)
+    RS_REGION_OTHER = 0,  // other skin (ears, neck, scalp, chin...)
     RS_REGION_CHEEK = 1,
     RS_REGION_NOSE = 2,
     RS_REGION_FOREHEAD = 3,
     RS_REGION_LIPS = 4,
-    RS_REGION_BUILTIN_COUNT = 5,
+    RS_REGION_BUILTIN_COUNT = 5,   // the regions a file must have
+    RS_REGION_EYELID = 5,          // the eye area: upper and lower lids, from the lash lines to the brow
+    RS_REGION_BROW = 6,            // eyebrows (hair)
+    RS_REGION_STANDARD_COUNT = 7,  // the regions rouge-pack writes
 } rs_region;
 
 // One splat as floats, in model units. Colour is sRGB-encoded 8-bit, as in the scan.

@@ -268,9 +268,10 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     for (uint32_t i = 0; i < in->vertex_count; i++) {
         if (!finite3(in->pos[i]))
             return rs_fail(err, RS_ERR_FORMAT, "vertex %u: position is not finite", i);
-        if (in->region && in->region[i] >= RS_REGION_BUILTIN_COUNT && in->region[i] != RS_PACK_REGION_AUTO)
+        if (in->region && in->region[i] >= RS_REGION_STANDARD_COUNT && in->region[i] != RS_PACK_REGION_AUTO)
             return rs_fail(err, RS_ERR_FORMAT,
-                           "vertex %u: region %u is not a region id (0 other, 1 cheek, 2 nose, 3 forehead, 4 lips, 255 automatic)",
+                           "vertex %u: region %u is not a region id (0 other, 1 cheek, 2 nose, 3 forehead, 4 lips, "
+                           "5 eyelid, 6 brow, 255 automatic)",
                            i, in->region[i]);
     }
     // Extents beyond 1e30 overflow squared distances and areas in float; no scan is that large.
@@ -405,7 +406,7 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
             sum[p.region[i]] += p.specular[i];
             cnt[p.region[i]]++;
         }
-        for (int k = 0; k < RS_REGION_BUILTIN_COUNT; k++)
+        for (int k = 0; k < RS_REGION_STANDARD_COUNT; k++)
             if (cnt[k]) rep->specular_mean[k] = (float)(sum[k] / cnt[k]);
     }
     step_end(&c);
@@ -434,6 +435,12 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     hdr->face_height = f->face_height;
     hdr->mm_per_unit = choose_scale(d, f, rep);
     rs_splat_default_regions(hdr);
+    // The regions brushes need beside the built-ins. Not measured by Weyrich et al.: thin lid skin takes
+    // the mean like `other`; brow hair scatters more broadly (rougher) and less (lower rho_s).
+    hdr->regions[RS_REGION_EYELID] = (rs_region_info){"eyelid", hdr->regions[RS_REGION_OTHER].m,
+                                                      hdr->regions[RS_REGION_OTHER].rho_s};
+    hdr->regions[RS_REGION_BROW] = (rs_region_info){"brow", 0.35f, 0.18f};
+    hdr->region_count = RS_REGION_STANDARD_COUNT;
     make_notes(hdr->notes, in->comments, d->notes);
     r = rs_splat_create(splats, n, hdr, out, err);
     if (r != RS_OK) goto out;

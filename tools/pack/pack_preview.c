@@ -5,10 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-// Preview colours per region id; ids past the built-ins cycle through the last ones.
-static const uint8_t region_rgb[RS_REGION_BUILTIN_COUNT][3] = {
+// Preview colours per region id (those of the renderer's `regions` view); other ids draw as `other`.
+static const uint8_t region_rgb[RS_REGION_STANDARD_COUNT][3] = {
     [RS_REGION_OTHER] = {150, 150, 150}, [RS_REGION_CHEEK] = {230, 40, 40}, [RS_REGION_NOSE] = {40, 200, 40},
-    [RS_REGION_FOREHEAD] = {50, 90, 240}, [RS_REGION_LIPS] = {240, 220, 30},
+    [RS_REGION_FOREHEAD] = {50, 90, 240}, [RS_REGION_LIPS] = {240, 220, 30}, [RS_REGION_EYELID] = {180, 80, 215},
+    [RS_REGION_BROW] = {50, 205, 215},
 };
 
 typedef struct view {
@@ -40,7 +41,7 @@ static void draw_panel(const rs_splat_cloud *c, const view *v, float scale, cons
         if (sx + r < 0 || sx - r > w || sy + r < 0 || sy - r > h) continue;
         // Headlight shading so the shape reads; colours stay sRGB, this is a debugging view.
         float shade = 0.3f + 0.7f * facing;
-        const uint8_t *base = regions ? region_rgb[s.region < RS_REGION_BUILTIN_COUNT ? s.region : 0] : s.rgb;
+        const uint8_t *base = regions ? region_rgb[s.region < RS_REGION_STANDARD_COUNT ? s.region : 0] : s.rgb;
         uint8_t col[3];
         for (int a = 0; a < 3; a++) col[a] = (uint8_t)lrintf(RS_MIN(255.0f, base[a] * shade));
         int xa = (int)floorf(sx - r), xb = (int)ceilf(sx + r), ya = (int)floorf(sy - r), yb = (int)ceilf(sy + r);

@@ -4,8 +4,9 @@
 // df = (...) . forward / H, with H the face height (vertex to menton). The lips follow the detected lip
 // line (a parabola through the mouth corners and the stomion); the nose, cheeks and forehead are boxes
 // and tapers placed at anthropometric offsets from the nose tip and the brow (glabella), with limits on
-// depth (df) and facing (normal . forward) that keep them on the front of the face. Order of
-// precedence: lips, nose, cheek, forehead; everything else is `other`.
+// depth (df) and facing (normal . forward) that keep them on the front of the face; brows and eyelids
+// hang from the brow line (glabella) on either side of the mid-line. Order of precedence: lips,
+// brow, eyelid, nose, cheek, forehead; everything else is `other`.
 #include "pack/pack.h"
 
 #include <math.h>
@@ -48,8 +49,19 @@ static uint8_t classify(const frame *fr, const float p[3], const float n[3])
     if (fabsf(t) <= 1.08f && df > -0.16f) {
         float line = fr->a + fr->b * (q[0] - fr->mouth_s) + fr->c * (q[0] - fr->mouth_s) * (q[0] - fr->mouth_s);
         float k = sqrtf(fmaxf(0.0f, 1.0f - t * t)), dv = (q[1] - line) / H;
-        if (dv <= 0.036f * k + 0.007f && dv >= -(0.026f * k + 0.007f)) return RS_REGION_LIPS;
+        if (dv <= 0.036f * k + 0.007f && dv >= -(0.018f * k + 0.005f)) return RS_REGION_LIPS;
     }
+    // Brows: an arched band over each orbit, highest above the middle of the eye and dropping toward the
+    // tail; the hairs sit ~3 % H below the glabella (measured on the bundled head, see docs/regions.md).
+    if (ads >= 0.045f && ads <= 0.25f && facing > 0.0f && df > -0.3f) {
+        float centre = fr->brow_du - 0.031f - 1.6f * (ads - 0.14f) * (ads - 0.14f);
+        if (fabsf(du - centre) <= 0.019f) return RS_REGION_BROW;
+    }
+    // Eyelids: the eye area around each eye (centre ~0.105 H below the glabella, 0.12 H beside the
+    // mid-line), from below the lower lash line up to the brow, where shadow and liner go. Before the
+    // nose, which would otherwise take the inner corners.
+    float lx = (ads - 0.12f) / 0.09f, dv = du - (fr->brow_du - 0.105f), ly = dv / (dv > 0.0f ? 0.085f : 0.05f);
+    if (ads >= 0.04f && lx * lx + ly * ly <= 1.0f && facing > -0.1f && df > -0.3f) return RS_REGION_EYELID;
     // Nose: from just below the tip (columella, alae) up to the nasion, narrowing toward the top.
     if (du >= -0.065f && du <= fr->brow_du - 0.03f && df > -0.11f - 0.05f * fmaxf(du, 0.0f) / 0.16f) {
         float half = du < 0.02f ? 0.075f : 0.075f - 0.04f * fminf(1.0f, (du - 0.02f) / 0.14f);

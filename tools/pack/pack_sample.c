@@ -18,12 +18,12 @@ void rs_pack_points_free(rs_pack_points *p)
 
 uint8_t rs_pack_region_from_rgb(const uint8_t rgb[3])
 {
-    static const uint8_t code[6][3] = {{0, 0, 0}, {255, 0, 0}, {0, 255, 0}, {0, 0, 255}, {255, 255, 0},
-                                       {255, 255, 255}};
-    static const uint8_t id[6] = {RS_REGION_OTHER, RS_REGION_CHEEK, RS_REGION_NOSE, RS_REGION_FOREHEAD,
-                                  RS_REGION_LIPS, RS_PACK_REGION_AUTO};
-    int best = 5, best_d = 1 << 30;
-    for (int i = 0; i < 6; i++) {
+    static const uint8_t code[8][3] = {{0, 0, 0},     {255, 0, 0},   {0, 255, 0},   {0, 0, 255},
+                                       {255, 255, 0}, {255, 0, 255}, {0, 255, 255}, {255, 255, 255}};
+    static const uint8_t id[8] = {RS_REGION_OTHER, RS_REGION_CHEEK,  RS_REGION_NOSE, RS_REGION_FOREHEAD,
+                                  RS_REGION_LIPS,  RS_REGION_EYELID, RS_REGION_BROW, RS_PACK_REGION_AUTO};
+    int best = 7, best_d = 1 << 30;
+    for (int i = 0; i < 8; i++) {
         int d = 0;
         for (int c = 0; c < 3; c++) d += (rgb[c] - code[i][c]) * (rgb[c] - code[i][c]);
         if (d < best_d) {
