@@ -844,7 +844,7 @@ static void test_region_mask_is_zero_outside_and_rises_softly_inside(void)
         float x = c->pos[i][0];
         bool lips = x < -1e-6f;
         if (!lips) bad += w[i] != 0;
-        else if (x < -edge - 1e-4f) bad += w[i] != 255;
+        else if (x < -edge - 0.002f) bad += w[i] != 255;  // the border is within a spacing left of x = 0
         else bad += w[i] == 0;  // inside and near the border: faded, never cut to nothing
     }
     RS_CHECK(bad == 0, "%d splats with the wrong weight", bad);
@@ -855,10 +855,11 @@ static void test_region_mask_is_zero_outside_and_rises_softly_inside(void)
         if (v >= 128) half_at = -c->pos[row + x][0] * c->hdr.mm_per_unit;  // the last one still above half
         last = v;
     }
-    // smoothstep(d / edge) = 1/2 at d = edge / 2, d measured to the nearest splat outside (at x = 0).
-    float spacing_mm = 0.002f * c->hdr.mm_per_unit;
-    RS_CHECK(half_at >= 0.5f * RS_MAKEUP_MASK_EDGE_MM - 1e-3f && half_at <= 0.5f * RS_MAKEUP_MASK_EDGE_MM + spacing_mm,
-             "weight halves %.2f mm inside the border", half_at);
+    // smoothstep(b / edge) = 1/2 at b = edge / 2, b the distance to the first splat outside (x = 0) less
+    // 0.75 of the nearest-neighbour distance (here the grid spacing).
+    float spacing_mm = 0.002f * c->hdr.mm_per_unit, half_b = half_at - 0.75f * spacing_mm;
+    RS_CHECK(half_b >= 0.5f * RS_MAKEUP_MASK_EDGE_MM - 1e-3f && half_b <= 0.5f * RS_MAKEUP_MASK_EDGE_MM + spacing_mm,
+             "weight halves %.2f mm inside the border", half_b);
     // The same table on demand; a table without an eyelid region has no eye mask (ignored), ANY none.
     const uint8_t *again = NULL, *eyes = (const uint8_t *)1, *any = (const uint8_t *)1;
     RS_CHECK(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_LIPS, &again, &err) == RS_OK && again == w, "rebuilt");

@@ -854,25 +854,35 @@ static bool lod_cloud(uint32_t n, rs_splat_cloud *out)
 // render is bit-identical. Loaded on a cloud that is only the drawn LOD (37k splats) and shown at that
 // LOD, it matches the full-cloud render within 3 levels on all but 0.1 % of pixels, max 8 (measured:
 // 0.003 %, max 4): each cloud computes its own skin-detail ratios and colour range (src/makeup/makeup.c)
-// from its own splats, so the records differ slightly.
-static void test_saved_look_renders_identically_on_the_same_and_a_coarser_lod(void)
+// from its own splats, so the records differ slightly. With the products kept to their regions (the
+// default) each cloud also builds its own region masks: a 1.5 mm fade at the lips' border sampled by
+// splats 2.5 mm apart on that LOD differs per splat, so the border may differ by up to 16 levels on
+// 0.3 % of the pixels (measured: 0.06 %, max 10); the unmasked strokes keep the tight bound.
+static void check_look_on_lods(bool masked)
 {
-    if (!need_face()) return;
     char path[512];
-    snprintf(path, sizeof path, "%s/paint_render.look", rs_test_out_dir());
+    snprintf(path, sizeof path, "%s/paint_render%s.look", rs_test_out_dir(), masked ? "_masked" : "");
     rs_image painted = {0}, loaded = {0}, coarse = {0};
     rs_error err = {0};
     rs_makeup_range d;
     rs_makeup *mk = new_layer(face);
-    bool ok = mk && replay_file(mk, "lips.strokes", NULL, NULL) && replay_file(mk, "cheek.strokes", NULL, NULL) &&
-              replay_file(mk, "forehead.strokes", NULL, NULL) && render_mode(RS_MODE_FULL, &painted);
+    static const char *const files[3] = {"lips.strokes", "cheek.strokes", "forehead.strokes"};
+    bool ok = mk != NULL;
+    for (int f = 0; f < 3 && ok; f++) {
+        rs_strokes *doc = load_strokes(files[f], NULL, NULL);
+        // Stroke files are read-only documents for callers; a test may flip the brush it replays.
+        for (uint32_t i = 0; doc && i < doc->count; i++) doc->strokes[i].brush.any_region = !masked;
+        ok = doc && replay_doc(mk, doc);
+        rs_strokes_destroy(doc);
+    }
+    ok = ok && render_mode(RS_MODE_FULL, &painted);
     ok = ok && RS_CHECK(rs_look_save(mk, path, &err) == RS_OK, "save: %s", err.msg);
     rs_makeup_destroy(mk);
     mk = ok ? new_layer(face) : NULL;
     ok = mk && RS_CHECK(rs_look_load(mk, path, &d, &err) == RS_OK, "load: %s", err.msg) && upload_dirty(mk) &&
          render_mode(RS_MODE_FULL, &loaded);
     rs_makeup_destroy(mk);
-    if (ok) same_image("look_same_cloud", &loaded, &painted);
+    if (ok) same_image(masked ? "look_same_cloud_masked" : "look_same_cloud", &loaded, &painted);
 
     static rs_splat_cloud lod;
     uint32_t n = rs_splat_lod_count(face, MAX_SPLATS);
@@ -884,17 +894,26 @@ static void test_saved_look_renders_identically_on_the_same_and_a_coarser_lod(vo
     if (ok) {
         rs_image_metrics m;
         RS_REQUIRE(rs_image_compare(&coarse, &painted, 3, &m, &err) == RS_OK, "%s", err.msg);
-        note("look on the %u-splat LOD: %.4f%% of pixels > 3 levels, max %d, PSNR %.1f dB", n, 100 * m.frac_over,
-             m.max_abs, m.psnr);
-        if (!RS_CHECK(m.frac_over <= 0.001 && m.max_abs <= 8,
-                      "look on the %u-splat LOD: %.3f%% of pixels differ by > 3 levels (allowed 0.1%%), max %d "
-                      "(allowed 8)",
-                      n, 100 * m.frac_over, m.max_abs))
-            save_failure("look_lod", &coarse, &painted);
+        note("look on the %u-splat LOD%s: %.4f%% of pixels > 3 levels, max %d, PSNR %.1f dB", n,
+             masked ? " (kept to regions)" : "", 100 * m.frac_over, m.max_abs, m.psnr);
+        double max_frac = masked ? 0.003 : 0.001;
+        int max_abs = masked ? 16 : 8;
+        if (!RS_CHECK(m.frac_over <= max_frac && m.max_abs <= max_abs,
+                      "look on the %u-splat LOD%s: %.3f%% of pixels differ by > 3 levels (allowed %.1f%%), max %d "
+                      "(allowed %d)",
+                      n, masked ? " (kept to regions)" : "", 100 * m.frac_over, 100 * max_frac, m.max_abs, max_abs))
+            save_failure(masked ? "look_lod_masked" : "look_lod", &coarse, &painted);
     }
     rs_image_free(&painted);
     rs_image_free(&loaded);
     rs_image_free(&coarse);
+}
+
+static void test_saved_look_renders_identically_on_the_same_and_a_coarser_lod(void)
+{
+    if (!need_face()) return;
+    check_look_on_lods(false);
+    check_look_on_lods(true);
 }
 
 // ---- mirror ----------------------------------------------------------------------------------------------

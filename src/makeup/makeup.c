@@ -521,6 +521,12 @@ static void build_range(rs_makeup *mk, const float lut[256])
 
 static uint32_t splat_region(const rs_makeup *mk, uint32_t i) { return mk->cloud->packed[i].w[1] >> 24; }
 
+static float dist2(const float a[3], const float b[3])
+{
+    float x = a[0] - b[0], y = a[1] - b[1], z = a[2] - b[2];
+    return x * x + y * y + z * z;
+}
+
 rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err)
 {
     *out = NULL;
@@ -561,18 +567,24 @@ rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, con
         free(cell_out);
         return RS_OK;
     }
-    // Soft edge: each splat inside takes smoothstep(d / edge), d the distance to the nearest splat
-    // outside; only cells within `reach` cells of one holding a splat outside need looking at.
+    // Soft edge: each splat inside takes smoothstep(b / edge), b its distance to the region's border. The
+    // border lies between the last splats inside and the first outside, so b = (distance to the nearest
+    // splat outside) - (half the local spacing), an estimate that does not depend on the LOD, so a look
+    // loads alike on a coarser one. The spacing comes from the nearest splat of any region: that distance
+    // is ~2/3 of the mean spacing of a Poisson-disk set, hence 0.75 of it (on the bundled face this
+    // balances the lips' mean weight between all splats and the 37k LOD: 208 and 206 of 255). Splats
+    // farther than `reach_d` from any splat outside take 1; only cells near one holding such a splat
+    // are looked at.
     float edge = RS_MAKEUP_MASK_EDGE_MM / (h->mm_per_unit > 0.0f ? h->mm_per_unit : 1.0f);
-    float e2 = edge * edge;
-    int reach = (int)ceilf(edge * mk->inv_cell);
-    reach = RS_CLAMP(reach, 1, 4);
+    float reach_d = 3.0f * edge, r2 = reach_d * reach_d;
+    int reach = RS_CLAMP((int)ceilf(reach_d * mk->inv_cell), 1, 4);
     for (uint32_t c = 0; c < mk->cell_count; c++) {
         const grid_cell *gc = &mk->cells[c];
         int cx = (int)(gc->key & 1023u), cy = (int)(gc->key >> 10 & 1023u), cz = (int)(gc->key >> 20 & 1023u);
-        // The neighbour cells holding splats outside, found once per cell (most cells have none).
-        const grid_cell *near[9 * 9 * 9];
-        int nn = 0;
+        // The neighbour cells holding splats outside, found once per cell (most cells have none), and the
+        // adjacent ones (for the spacing).
+        const grid_cell *near[9 * 9 * 9], *adj[27];
+        int nn = 0, na = 0;
         for (int dz = -reach; dz <= reach; dz++)
             for (int dy = -reach; dy <= reach; dy++)
                 for (int dx = -reach; dx <= reach; dx++) {
@@ -581,25 +593,27 @@ rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, con
                         (uint32_t)z >= mk->dim[2])
                         continue;
                     const grid_cell *nc = find_cell(mk, cell_key((uint32_t)x, (uint32_t)y, (uint32_t)z));
-                    if (nc && cell_out[nc - mk->cells]) near[nn++] = nc;
+                    if (!nc) continue;
+                    if (cell_out[nc - mk->cells]) near[nn++] = nc;
+                    if (abs(dx) <= 1 && abs(dy) <= 1 && abs(dz) <= 1) adj[na++] = nc;
                 }
         for (uint32_t k = gc->start; nn && k < gc->start + gc->count; k++) {
             uint32_t i = mk->order[k];
             if (!w[i]) continue;
             const float *p = mk->cloud->pos[i];
-            float d2 = e2;
+            float out2 = r2, any2 = r2;
             for (int q = 0; q < nn; q++)
                 for (uint32_t m = near[q]->start; m < near[q]->start + near[q]->count; m++) {
                     uint32_t j = mk->order[m];
                     if (allowed[splat_region(mk, j)]) continue;
-                    const float *o = mk->cloud->pos[j];
-                    float ex = o[0] - p[0], ey = o[1] - p[1], ez = o[2] - p[2];
-                    d2 = RS_MIN(d2, ex * ex + ey * ey + ez * ez);
+                    out2 = RS_MIN(out2, dist2(mk->cloud->pos[j], p));
                 }
-            if (d2 < e2) {
-                float t = sqrtf(d2 / e2);
-                w[i] = (uint8_t)RS_MAX(1, lrintf(255.0f * t * t * (3.0f - 2.0f * t)));
-            }
+            if (!(out2 < r2)) continue;
+            for (int q = 0; q < na; q++)
+                for (uint32_t m = adj[q]->start; m < adj[q]->start + adj[q]->count; m++)
+                    if (mk->order[m] != i) any2 = RS_MIN(any2, dist2(mk->cloud->pos[mk->order[m]], p));
+            float t = RS_CLAMP((sqrtf(out2) - 0.75f * sqrtf(any2)) / edge, 0.0f, 1.0f);
+            w[i] = (uint8_t)RS_MAX(1, lrintf(255.0f * t * t * (3.0f - 2.0f * t)));
         }
     }
     free(cell_out);

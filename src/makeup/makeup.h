@@ -158,9 +158,9 @@ uint32_t rs_makeup_log_cosmetic_count(const rs_makeup *mk);
 const rs_cosmetic *rs_makeup_log_cosmetic(const rs_makeup *mk, uint32_t i);
 
 // Per-splat weights (q/255) of a region mask, built on first use and kept: 0 outside the regions the
-// mask allows, rising as a smoothstep to 255 over RS_MAKEUP_MASK_EDGE_MM from the nearest splat
-// outside (measured in 3D), so products fade in at a region's border instead of stopping at a hard
-// line. *out = NULL when no splat of this face is in the mask (a file without eyelids: the mask is
+// mask allows, rising as a smoothstep to 255 over RS_MAKEUP_MASK_EDGE_MM from the region's border (the
+// distance to the nearest splat outside, in 3D, less about half the local spacing: alike on every LOD), so
+// products fade in at a region's border instead of stopping at a hard line. *out = NULL when no splat of this face is in the mask (a file without eyelids: the mask is
 // then ignored) or for RS_COSMETIC_REGION_ANY. Fails only on out-of-memory.
 rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err);
 
