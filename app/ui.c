@@ -569,27 +569,53 @@ bool rs_ui_swatch(rs_ui *ui, int id, rs_ui_rect r, const uint8_t rgb[3], bool se
     return tap;
 }
 
-bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, float *value)
+bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, const char *label, const char *value_text,
+                  float *value)
 {
     bool hot;
     press_logic(ui, id, r, &hot);
     float s = ui->scale;
     bool vertical = r.h > r.w;
-    float icon_sz = (vertical ? r.w : r.h) * 0.5f;
-    // Track from a (value 0) to b (value 1), leaving room for the icon at the low end.
+    float icon_sz = RS_MIN(r.w, r.h) * 0.5f;
+    if (vertical) icon_sz = RS_MIN(icon_sz, 24 * s);
+    // Text: the name small and dim, the value at the toolbar's text size, centred above a vertical track
+    // (after a horizontal one).
+    int ts = RS_MAX(1, (int)floorf(s * 2 + 0.25f)), ts_small = RS_MAX(1, (int)floorf(s + 0.25f));
+    float text_h = (label ? 11.0f * (float)ts_small + 3 * s : 0) + (value_text ? 9.0f * (float)ts : 0);
+    if (vertical && (label || value_text)) {
+        float ty = r.y + 2 * s;
+        if (label) {
+            float w = rs_ui_text_width(label, ts_small);
+            rs_ui_text(ui, r.x + (r.w - w) * 0.5f, ty, ts_small, RS_UI_DIM, label);
+            ty += 11.0f * (float)ts_small + 3 * s;
+        }
+        if (value_text) {
+            float w = rs_ui_text_width(value_text, ts);
+            rs_ui_text(ui, r.x + (r.w - w) * 0.5f, ty, ts, RS_UI_WHITE, value_text);
+        }
+    }
+    // Track from a (value 0) to b (value 1), leaving room for the icon at the low end (a vertical slider
+    // with a name needs no icon: the track takes the room).
     float ax, ay, bx, by;
     float knob = 11 * s;
     if (vertical) {
         ax = bx = r.x + r.w * 0.5f;
-        ay = r.y + r.h - icon_sz * 2.0f - knob;
-        by = r.y + knob + 4 * s;
-        rs_ui_icon_draw(ui, icon, (rs_ui_rect){ax - icon_sz * 0.5f, r.y + r.h - icon_sz * 1.5f, icon_sz, icon_sz},
-                        RS_UI_DIM);
+        ay = r.y + r.h - knob - 4 * s - (label ? 0 : icon_sz * 2.0f - 4 * s);
+        by = r.y + knob + 4 * s + (text_h > 0 ? text_h + 6 * s : 0);
+        if (!label)
+            rs_ui_icon_draw(ui, icon, (rs_ui_rect){ax - icon_sz * 0.5f, r.y + r.h - icon_sz * 1.5f, icon_sz, icon_sz},
+                            RS_UI_DIM);
     } else {
         ay = by = r.y + r.h * 0.5f;
         ax = r.x + icon_sz * 2.0f + knob;
-        bx = r.x + r.w - knob - 4 * s;
+        float text_w = 0;
+        if (label) text_w += rs_ui_text_width(label, ts_small) + 8 * s;
+        if (value_text) text_w += rs_ui_text_width(value_text, ts) + 8 * s;
+        bx = r.x + r.w - knob - 4 * s - text_w;
         rs_ui_icon_draw(ui, icon, (rs_ui_rect){r.x + icon_sz * 0.5f, ay - icon_sz * 0.5f, icon_sz, icon_sz}, RS_UI_DIM);
+        float tx = bx + knob + 8 * s;
+        if (label) tx += rs_ui_text(ui, tx, ay - 4.5f * (float)ts_small, ts_small, RS_UI_DIM, label) + 8 * s;
+        if (value_text) rs_ui_text(ui, tx, ay - 4.5f * (float)ts, ts, RS_UI_WHITE, value_text);
     }
     float old = *value;
     if (ui->active == id) {

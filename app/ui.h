@@ -128,7 +128,10 @@ bool rs_ui_text_button(rs_ui *ui, int id, rs_ui_rect r, const char *label, bool 
 // A round colour swatch (rgb sRGB) in r; selected draws a ring around it. True when tapped.
 bool rs_ui_swatch(rs_ui *ui, int id, rs_ui_rect r, const uint8_t rgb[3], bool selected);
 // A slider along the long side of r (vertical sliders grow upwards); *value in 0..1. True when changed.
-bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, float *value);
+// `label` ("Size") and `value_text` ("18 mm") are drawn at the track's far end (vertical: above it);
+// either may be NULL.
+bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, const char *label, const char *value_text,
+                  float *value);
 // A draggable area: true while held; *dx, *dy = pointer motion since the last frame (pixels).
 bool rs_ui_drag(rs_ui *ui, int id, rs_ui_rect r, float *dx, float *dy);
 
@@ -168,6 +171,10 @@ typedef enum rs_ui_tool {
 } rs_ui_tool;
 
 #define RS_UI_TOOLBAR_MAX_SWATCHES 32
+// The light dial is RS_UI_DIAL_PT points across; a drag moves the sun by (drag / RS_UI_DIAL_DRAG_PT) of the
+// dial's radius whatever the dial's size, so a 22-point flick turns the light ~15 deg, not under the chin.
+#define RS_UI_DIAL_PT 84.0f
+#define RS_UI_DIAL_DRAG_PT 120.0f
 
 typedef struct rs_ui_toolbar_layout {
     rs_ui_rect top, left, right, bottom;   // panels
@@ -185,7 +192,9 @@ typedef struct rs_ui_toolbar_state {
     const char *region_name;               // where the brush stays ("lips"), shown by the name; NULL: anywhere
     int selected;                          // swatch index, -1 none
     float size, opacity;                   // slider values 0..1 (the viewer maps them to brush units)
-    float light[2];                        // light dial position in the unit disc (x right, y up)
+    const char *size_text, *opacity_text;  // what they mean, shown on the sliders ("18 mm", "80%"); may be NULL
+    float light[2];                        // light dial position in the unit disc (x right, y up); dragging
+                                           // the sun moves it by the drag / RS_UI_DIAL_DRAG_PT points
     bool paint, eraser, mirror, keep_region, split, hud, help;
     bool can_undo, can_redo;
     int mode;                              // 0 albedo, 1 diffuse, 2 full

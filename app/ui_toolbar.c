@@ -15,7 +15,6 @@
 #define PIPE_W_PT 124.0f     // "Reference" at text scale 2
 #define SEP_PT 10.0f
 #define LABEL_H_PT 24.0f
-#define DIAL_PT 56.0f
 #define SLIDER_MAX_PT 200.0f
 
 static const rs_ui_tool top_icons[] = {RS_UI_TOOL_SPLIT, RS_UI_TOOL_HUD, RS_UI_TOOL_SAVE,
@@ -77,7 +76,9 @@ void rs_ui_toolbar_layout_compute(int fb_w, int fb_h, float scale, int swatch_co
         y += t;
     }
 
-    float dial = DIAL_PT * s;
+    // Right rail: the light dial, then the size and opacity sliders as wide as the rail (their names and
+    // values sit above their tracks).
+    float dial = RS_UI_DIAL_PT * s;
     float slider = RS_MIN(SLIDER_MAX_PT * s, (band1 - band0 - 2 * pad - dial - 2 * g) * 0.5f);
     slider = RS_MAX(slider, 2 * t);
     float rw = RS_MAX(t, dial) + 2 * pad, rh = 2 * pad + dial + 2 * g + 2 * slider;
@@ -86,9 +87,9 @@ void rs_ui_toolbar_layout_compute(int fb_w, int fb_h, float scale, int swatch_co
     y = out->right.y + pad;
     out->tool[RS_UI_TOOL_LIGHT] = (rs_ui_rect){cx - dial * 0.5f, y, dial, dial};
     y += dial + g;
-    out->tool[RS_UI_TOOL_SIZE] = (rs_ui_rect){cx - t * 0.5f, y, t, slider};
+    out->tool[RS_UI_TOOL_SIZE] = (rs_ui_rect){out->right.x + pad, y, rw - 2 * pad, slider};
     y += slider + g;
-    out->tool[RS_UI_TOOL_OPACITY] = (rs_ui_rect){cx - t * 0.5f, y, t, slider};
+    out->tool[RS_UI_TOOL_OPACITY] = (rs_ui_rect){out->right.x + pad, y, rw - 2 * pad, slider};
 }
 
 rs_ui_tool rs_ui_toolbar_hit(const rs_ui_toolbar_layout *l, float x, float y, int *swatch)
@@ -103,18 +104,19 @@ rs_ui_tool rs_ui_toolbar_hit(const rs_ui_toolbar_layout *l, float x, float y, in
     return RS_UI_TOOL_NONE;
 }
 
-// The light dial: a disc of light directions (centre = light from the camera) with a sun to drag; a tap
-// jumps the sun to the pointer. True while held.
+// The light dial: a disc of light directions (centre = light from the camera) with a sun to drag. The
+// drag moves the sun relative to where it was, geared down (RS_UI_DIAL_DRAG_PT points of drag cross
+// the dial's radius): a touch anywhere on the dial does not make the light jump, and a small flick
+// makes a small change. True while held.
 static bool light_dial(rs_ui *ui, rs_ui_rect r, float light[2])
 {
     float s = rs_ui_scale(ui);
     float cx = r.x + r.w * 0.5f, cy = r.y + r.h * 0.5f, R = r.w * 0.5f - 10 * s;
     float dx, dy;
     bool held = rs_ui_drag(ui, (int)(1000 + RS_UI_TOOL_LIGHT), r, &dx, &dy);
-    if (held) {
-        float px, py;
-        rs_ui_pointer(ui, &px, &py);
-        float x = (px - cx) / R, y = -(py - cy) / R, d = sqrtf(x * x + y * y);
+    if (held && (dx != 0 || dy != 0)) {
+        float k = 1.0f / (RS_UI_DIAL_DRAG_PT * s);
+        float x = light[0] + dx * k, y = light[1] - dy * k, d = sqrtf(x * x + y * y);
         if (d > 1) x /= d, y /= d;
         light[0] = x, light[1] = y;
     }
@@ -188,9 +190,11 @@ rs_ui_tool rs_ui_toolbar(rs_ui *ui, const rs_ui_toolbar_layout *l, rs_ui_toolbar
     // Right rail: light dial, brush size, opacity.
     rs_ui_panel(ui, l->right, rad);
     if (light_dial(ui, l->tool[RS_UI_TOOL_LIGHT], st->light)) hit = RS_UI_TOOL_LIGHT;
-    if (rs_ui_slider(ui, 1000 + RS_UI_TOOL_SIZE, l->tool[RS_UI_TOOL_SIZE], RS_UI_ICON_DOT, &st->size))
+    if (rs_ui_slider(ui, 1000 + RS_UI_TOOL_SIZE, l->tool[RS_UI_TOOL_SIZE], RS_UI_ICON_DOT, "Size", st->size_text,
+                     &st->size))
         hit = RS_UI_TOOL_SIZE;
-    if (rs_ui_slider(ui, 1000 + RS_UI_TOOL_OPACITY, l->tool[RS_UI_TOOL_OPACITY], RS_UI_ICON_DROP, &st->opacity))
+    if (rs_ui_slider(ui, 1000 + RS_UI_TOOL_OPACITY, l->tool[RS_UI_TOOL_OPACITY], RS_UI_ICON_DROP, "Opacity",
+                     st->opacity_text, &st->opacity))
         hit = RS_UI_TOOL_OPACITY;
 
     // Bottom sheet: product name and swatches.

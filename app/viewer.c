@@ -78,7 +78,8 @@ void rs_app_print_viewer_help(FILE *f)
     for (size_t i = 0; i < vw_shortcut_count; i++) fprintf(f, "  %-26s %s\n", vw_shortcuts[i].keys, vw_shortcuts[i].what);
     fprintf(f, "  Middle drag pans too; Shift+Tab picks the previous cosmetic; Ctrl+Shift+Z redoes; Esc closes\n"
                "  the help, then the split. The toolbar does all of it by touch: swatches pick a cosmetic (and\n"
-               "  paint mode), the right rail holds the light dial, brush size and opacity; drag the split's\n"
+               "  paint mode), the right rail holds the light dial (drag the sun: the light follows geared down,\n"
+               "  120 points of drag from the centre to the rim), brush size (mm) and opacity (%%); drag the split's\n"
                "  divider to compare. The look is saved to / loaded from --look FILE (default ./%s).\n"
                "  While orbiting or painting a coarser LOD (then a lower resolution) keeps frames near %.0f ms;\n"
                "  the picture refines to full quality when idle.\n",

@@ -239,11 +239,16 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
     }
     rs_ui_toolbar_layout l;
     rs_ui_toolbar_layout_compute(v->fb_w, v->fb_h, v->ui_scale, n, &l);
+    // The brush as a person measures it: its diameter on the face in mm, and its opacity in percent.
+    const rs_splat_header *h = &v->cloud->hdr;
+    snprintf(v->size_text, sizeof v->size_text, "%.0f mm", v->size_rel * h->face_height * h->mm_per_unit);
+    snprintf(v->opacity_text, sizeof v->opacity_text, "%.0f%%", v->opacity * 100.0f);
     *st = (rs_ui_toolbar_state){
         .swatch_count = n, .swatch_rgb = (const uint8_t(*)[3])v->swatch_rgb,
         .swatch_name = (const char *const *)v->swatch_name_ptr, .selected = v->cosmetic,
         .region_name = vw_brush_region(v),
-        .size = vw_size_to_slider(v->size_rel), .opacity = v->opacity,
+        .size = vw_size_to_slider(v->size_rel), .opacity = v->opacity, .size_text = v->size_text,
+        .opacity_text = v->opacity_text,
         .light = {v->light_dial[0], v->light_dial[1]}, .paint = v->paint_mode, .eraser = v->eraser,
         .mirror = v->mirror, .keep_region = !v->any_region, .split = v->split, .hud = v->hud, .help = v->help,
         .can_undo = rs_makeup_can_undo(v->mk), .can_redo = rs_makeup_can_redo(v->mk),

@@ -245,6 +245,7 @@ typedef struct vw_viewer {
     uint8_t swatch_rgb[RS_UI_TOOLBAR_MAX_SWATCHES][3];  // the toolbar's swatches, rebuilt each frame
     char swatch_names[RS_UI_TOOLBAR_MAX_SWATCHES][RS_COSMETIC_NAME_MAX];
     const char *swatch_name_ptr[RS_UI_TOOLBAR_MAX_SWATCHES];
+    char size_text[24], opacity_text[24];  // the sliders' values as shown ("18 mm", "80%")
     bool want_face_shot;        // the screenshot action: taken once the picture is drawn, before the UI
     bool quit;
 } vw_viewer;

@@ -328,6 +328,91 @@ static void test_slider_follows_the_pointer_and_clamps(void)
     rs_ui_destroy(ui);
 }
 
+// The sun dial (issue 15): large enough to aim with a finger, and geared: pressing anywhere on it does not
+// make the light jump, a 22-pixel drag turns the light by less than a fifth of the dial's range (~17
+// degrees; it once swung the light under the chin), and a long drag still reaches the rim.
+static void test_light_dial_is_large_and_geared(void)
+{
+    rs_ui *ui = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_ui_create(&ui, &err) == RS_OK, "%s", err.msg);
+    target t;
+    target_begin(&t, 800, 600);
+    rs_ui_toolbar_layout l;
+    rs_ui_toolbar_layout_compute(800, 600, 1, 15, &l);
+    rs_ui_rect d = l.tool[RS_UI_TOOL_LIGHT];
+    RS_CHECK(d.w >= 80 && d.h >= 80, "the dial is %gx%g pt", d.w, d.h);
+    uint8_t rgb[15][3] = {{0}};
+    rs_ui_toolbar_state st = {.swatch_count = 15, .swatch_rgb = (const uint8_t(*)[3])rgb, .light = {0.0f, 0.4f}};
+    float cx = d.x + d.w / 2, cy = d.y + d.h / 2;
+    // Press on the dial's centre (away from the sun), drag 22 px down over a few frames, release.
+    const float ys[6] = {cy, cy, cy + 8, cy + 15, cy + 22, cy + 22};
+    float after_press = 0;
+    for (int i = 0; i < 6; i++) {
+        rs_ui_input in = {.x = cx, .y = ys[i], .down = i < 5, .pressed = i == 0, .released = i == 5, .inside = true};
+        rs_ui_begin(ui, 800, 600, 1, &in);
+        rs_ui_toolbar(ui, &l, &st, NULL);
+        rs_ui_end(ui);
+        if (i == 1) after_press = st.light[1];
+    }
+    RS_CHECK(fabsf(after_press - 0.4f) < 1e-6f && st.light[0] == 0.0f, "a press moved the light to (%g, %g)",
+             st.light[0], after_press);
+    float moved = 0.4f - st.light[1];
+    RS_CHECK(moved > 0.1f && moved < 0.2f, "a 22 px drag down moved the light by %.3f of the dial's radius", moved);
+    // A long drag to the right ends on the rim, not beyond it.
+    for (int i = 0; i < 12; i++) {
+        rs_ui_input in = {.x = cx + 30.0f * (float)i, .y = cy, .down = i < 11, .pressed = i == 0, .released = i == 11,
+                          .inside = true};
+        rs_ui_begin(ui, 800, 600, 1, &in);
+        rs_ui_toolbar(ui, &l, &st, NULL);
+        rs_ui_end(ui);
+    }
+    float r = hypotf(st.light[0], st.light[1]);
+    RS_CHECK(r > 0.99f && r < 1.001f && st.light[0] > 0.9f, "after a long drag the light is at (%g, %g)", st.light[0],
+             st.light[1]);
+    target_end(&t);
+    rs_ui_destroy(ui);
+}
+
+// Labelled sliders: each shows its name and value above its track (ink there with texts, none without).
+static void test_sliders_show_their_names_and_values(void)
+{
+    rs_ui *ui = NULL;
+    rs_error err = {0};
+    RS_REQUIRE(rs_ui_create(&ui, &err) == RS_OK, "%s", err.msg);
+    rs_ui_toolbar_layout l;
+    rs_ui_toolbar_layout_compute(800, 600, 1, 15, &l);
+    uint8_t rgb[15][3] = {{0}};
+    int ink[2][2] = {{0}};
+    for (int with = 0; with < 2; with++) {
+        target t;
+        target_begin(&t, 800, 600);
+        rs_ui_toolbar_state st = {.swatch_count = 15, .swatch_rgb = (const uint8_t(*)[3])rgb, .size = 0.0f,
+                                  .opacity = 0.0f, .size_text = with ? "18 mm" : NULL,
+                                  .opacity_text = with ? "80%" : NULL};
+        rs_ui_begin(ui, 800, 600, 1, &(rs_ui_input){.x = -1, .y = -1});
+        rs_ui_toolbar(ui, &l, &st, NULL);
+        rs_ui_end(ui);
+        rs_image img = {0};
+        RS_REQUIRE(rs_ui_read_pixels(800, 600, &img, &err) == RS_OK, "%s", err.msg);
+        // The top 30 px of each slider (with value 0 the knob sits at the bottom).
+        const rs_ui_tool sl[2] = {RS_UI_TOOL_SIZE, RS_UI_TOOL_OPACITY};
+        for (int k = 0; k < 2; k++) {
+            rs_ui_rect r = l.tool[sl[k]];
+            for (int y = (int)r.y; y < (int)r.y + 30; y++)
+                for (int x = (int)r.x; x < (int)(r.x + r.w); x++)
+                    ink[with][k] += img.pixels[((size_t)y * 800 + (size_t)x) * 4 + 1] > 200;
+        }
+        rs_image_free(&img);
+        target_end(&t);
+    }
+    RS_CHECK(ink[1][0] > 40 && ink[1][1] > 40, "size / opacity labels drew %d / %d bright pixels", ink[1][0], ink[1][1]);
+    // Without value texts the names still show (dimmer than white): the value is what adds white ink.
+    RS_CHECK(ink[0][0] < ink[1][0] && ink[0][1] < ink[1][1], "the values add no ink (%d/%d vs %d/%d)", ink[0][0],
+             ink[0][1], ink[1][0], ink[1][1]);
+    rs_ui_destroy(ui);
+}
+
 // A fixed palette so the golden image does not change when the cosmetics presets are tuned.
 static const uint8_t golden_rgb[15][3] = {
     {242, 208, 182}, {222, 178, 146}, {178, 128, 96}, {236, 218, 204}, {220, 112, 122},
@@ -350,6 +435,7 @@ static void render_toolbar(int w, int h, float scale, rs_image *out)
     rs_ui_toolbar_layout_compute(w, h, scale, 15, &l);
     rs_ui_toolbar_state st = {.swatch_count = 15, .swatch_rgb = golden_rgb, .swatch_name = golden_names,
                               .selected = 9, .size = 0.35f, .opacity = 0.7f, .light = {-0.45f, 0.4f},
+                              .size_text = "18 mm", .opacity_text = "70%",
                               .paint = true, .mirror = true, .keep_region = true, .region_name = "lips",
                               .can_undo = true, .mode = 2, .mobile = true};
     rs_ui_begin(ui, w, h, scale, &(rs_ui_input){.x = -1, .y = -1});
@@ -424,6 +510,8 @@ int main(int argc, char **argv)
     RS_RUN(test_captures_routes_presses_on_panels_to_the_ui);
     RS_RUN(test_drag_counts_from_the_press_not_the_hover);
     RS_RUN(test_slider_follows_the_pointer_and_clamps);
+    RS_RUN(test_light_dial_is_large_and_geared);
+    RS_RUN(test_sliders_show_their_names_and_values);
     RS_RUN(test_toolbar_render_matches_golden);
     RS_RUN(test_toolbar_render_at_2x_is_the_1x_layout_doubled);
     rs_gl_destroy(gl);

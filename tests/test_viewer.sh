@@ -250,15 +250,16 @@ if selected viewer_bad_dropped_file_keeps_the_face; then
     else echo "FAIL - $name: the face changed after a bad drop: $why"; fi
 fi
 if selected viewer_key_0_resets_camera_and_light; then
-    # The sun dial sits at (726, 86) 56x56 on an 800x600 window (rs_ui_toolbar_layout_compute, scale 1):
-    # a tap in its upper-left moves the light, arrows orbit; `0` must bring back the picture as it started.
+    # The sun dial sits at (698, 86) 84x84 on an 800x600 window (rs_ui_toolbar_layout_compute, scale 1):
+    # a drag on it moves the light (geared: 50 px drag = 0.42 of the dial), arrows orbit; `0` must bring
+    # back the picture as it started.
     name=viewer_key_0_resets_camera_and_light
     {
         echo "key i"
         echo "move 400 580"
         echo "idle"
         echo "screenshot $out/r0before_face.png 80 80 630 330"
-        echo "click 734 96"
+        echo "drag 740 128 690 100 10"
         echo "key left"
         echo "move 400 580"
         echo "idle"
