@@ -6,6 +6,7 @@
 #define RS_APP_APP_H
 
 #include "cli.h"
+#include "core/image.h"
 #include "rouge.h"
 
 #define RS_APP_VERSION "0.1.0"
@@ -24,6 +25,15 @@ rouge_view rs_app_public_view(const rs_view *v, const char *env);
 const char *rs_app_env_dir(char *buf, size_t n);
 // A public API failure as the app's error (same codes, same message); returns the code.
 rs_result rs_app_error(rouge_result r, const rouge_error *e, rs_error *err);
+// `rouge looks ...` (looks_cmd.c): argv after "looks".
+rs_result rs_app_looks(int argc, char **argv, rs_error *err);
+void rs_app_print_looks_help(FILE *f);
+// Thumbnails of the look library: a frontal close-up from brows to chin, the same from the CLI and the
+// viewer. rs_app_thumbnail renders one headlessly (its own EGL context) as an RGB image.
+#define RS_APP_THUMB_ZOOM 1.7f
+#define RS_APP_THUMB_PAN_Y (-0.2f)  // view heights: the face moves up, the lips come into the frame
+rouge_view rs_app_thumbnail_view(void);
+rs_result rs_app_thumbnail(const char *face_path, const void *look, size_t len, rs_image *out, rs_error *err);
 // The GLFW viewer (viewer.c).
 rs_result rs_app_view(const rs_cli *cli, rs_error *err);
 void rs_app_print_viewer_help(FILE *f);

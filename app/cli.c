@@ -52,6 +52,7 @@ static const opt opts[] = {
     {"--strokes", OPT_PATH, "FILE", "replay a stroke file (painting) before rendering", 0, 0},
     {"--look", OPT_PATH, "FILE", "apply a saved look (makeup layer)", 0, 0},
     {"--save-look", OPT_PATH, "FILE", "save the look after replaying strokes", 0, 0},
+    {"--looks", OPT_PATH, "DIR", "viewer: the look library (default $XDG_DATA_HOME/rouge/looks)", 0, 0},
     {"--record", OPT_PATH, "FILE", "viewer: record strokes to FILE", 0, 0},
     {"--fullscreen", OPT_FLAG, NULL, "viewer: start full-screen", 0, 0},
     {"--events", OPT_PATH, "FILE", "viewer: replay an event script (format: see 'event scripts' below)", 0, 0},
@@ -166,6 +167,7 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--env-rotate")) w->env_rotate_deg = f;
     else if (!strcmp(n, "--save-look")) c->save_look = v;
     else if (!strcmp(n, "--record")) c->record = v;
+    else if (!strcmp(n, "--looks")) c->looks = v;
     else if (!strcmp(n, "--fullscreen")) c->fullscreen = true;
     else if (!strcmp(n, "--events")) c->events = v;
     else if (!strcmp(n, "--bench-orbit")) c->bench_orbit = (int)f;

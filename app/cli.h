@@ -24,6 +24,7 @@ typedef struct rs_cli {
     bool pan_set;           // --pan given (it then also shifts a --target or stroke file's framing)
     const char *save_look;  // --save-look FILE: save the look after replaying strokes
     const char *record;     // --record FILE: viewer records strokes
+    const char *looks;      // --looks DIR: the viewer's look library (NULL: rs_looklib_default_dir)
     const char *events;     // --events FILE: viewer replays an event script (tests, demos)
     int bench_orbit;        // --bench-orbit N: viewer orbits N frames, prints frame times, exits (0: off)
     rs_view view;

@@ -15,12 +15,15 @@ static void usage(FILE *f)
             "                                           reads standard input; a large .rsf (version 2) shows its\n"
             "                                           first LOD level at once and refines as the rest arrives\n"
             "  rouge render [FACE.rsf] -o OUT.png [options]  render headlessly (EGL) to a PNG\n"
+            "  rouge looks list|save|rm|path ...         the look library (see below)\n"
             "  rouge --help | --version\n"
             "\n"
             "options:\n");
     rs_cli_print_options(f);
     fprintf(f, "\n");
     rs_app_print_viewer_help(f);
+    fprintf(f, "\n");
+    rs_app_print_looks_help(f);
     fprintf(f, "\nFace data: see assets/README.md for the bundled scan's attribution (CC BY 3.0).\n");
 }
 
@@ -34,6 +37,16 @@ int main(int argc, char **argv)
     if (!strcmp(cmd, "--version")) {
         printf("rouge %s\n", RS_APP_VERSION);
         return 0;
+    }
+    if (!strcmp(cmd, "looks")) {
+        if (argc > 2 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) {
+            rs_app_print_looks_help(stdout);
+            return 0;
+        }
+        rs_error err = {0};
+        rs_result r = rs_app_looks(argc - 2, argv + 2, &err);
+        if (r != RS_OK) fprintf(stderr, "rouge: %s\n", err.msg);
+        return r == RS_OK ? 0 : r == RS_ERR_ARG ? 2 : 1;
     }
     bool render = !strcmp(cmd, "render");
     int first = (render || !strcmp(cmd, "view")) ? 2 : 1;

@@ -631,6 +631,17 @@ bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, const char *
     return *value != old;
 }
 
+bool rs_ui_area(rs_ui *ui, int id, rs_ui_rect r)
+{
+    bool hot;
+    return press_logic(ui, id, r, &hot);
+}
+
+bool rs_ui_hot(const rs_ui *ui, int id, rs_ui_rect r)
+{
+    return rs_ui_rect_contains(r, ui->in.x, ui->in.y) && ui->in.inside && (ui->active == 0 || ui->active == id);
+}
+
 bool rs_ui_drag(rs_ui *ui, int id, rs_ui_rect r, float *dx, float *dy)
 {
     bool hot, was_active = ui->active == id;
@@ -680,6 +691,42 @@ rs_result rs_ui_texture_copy(rs_ui_texture *dst, GLuint src, int w, int h, rs_er
     glBindFramebuffer(GL_READ_FRAMEBUFFER, (GLuint)prev_read);
     if (r == RS_OK) r = rs_gl_check("ui: texture copy", err);
     return r;
+}
+
+rs_result rs_ui_texture_upload(rs_ui_texture *dst, const rs_image *img, rs_error *err)
+{
+    if (!img->pixels || img->width <= 0 || img->height <= 0 || (img->channels != 3 && img->channels != 4))
+        return rs_fail(err, RS_ERR_ARG, "ui: texture upload of an empty or odd image");
+    // GLES 3 uploads into RGBA8 storage only from RGBA data: widen RGB first.
+    const uint8_t *px = img->pixels;
+    uint8_t *rgba = NULL;
+    if (img->channels == 3) {
+        rgba = rs_alloc_array((size_t)img->width * (size_t)img->height, 4);
+        if (!rgba) return rs_fail(err, RS_ERR_NOMEM, "ui: texture upload: out of memory");
+        for (size_t i = 0; i < (size_t)img->width * (size_t)img->height; i++) {
+            memcpy(rgba + i * 4, img->pixels + i * 3, 3);
+            rgba[i * 4 + 3] = 255;
+        }
+        px = rgba;
+    }
+    if (!dst->tex || dst->width != img->width || dst->height != img->height) {
+        rs_ui_texture_free(dst);
+        glGenTextures(1, &dst->tex);
+        glBindTexture(GL_TEXTURE_2D, dst->tex);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA8, img->width, img->height);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        dst->width = img->width, dst->height = img->height;
+    }
+    glBindTexture(GL_TEXTURE_2D, dst->tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, img->width, img->height, GL_RGBA, GL_UNSIGNED_BYTE, px);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    free(rgba);
+    return rs_gl_check("ui: texture upload", err);
 }
 
 void rs_ui_texture_free(rs_ui_texture *t)

@@ -132,6 +132,10 @@ bool rs_ui_swatch(rs_ui *ui, int id, rs_ui_rect r, const uint8_t rgb[3], bool se
 // either may be NULL.
 bool rs_ui_slider(rs_ui *ui, int id, rs_ui_rect r, rs_ui_icon icon, const char *label, const char *value_text,
                   float *value);
+// An invisible tap target (a thumbnail, a modal sheet's background): true when tapped.
+bool rs_ui_area(rs_ui *ui, int id, rs_ui_rect r);
+// Whether the pointer is over r and no other widget holds it (hover feedback for rs_ui_area).
+bool rs_ui_hot(const rs_ui *ui, int id, rs_ui_rect r);
 // A draggable area: true while held; *dx, *dy = pointer motion since the last frame (pixels).
 bool rs_ui_drag(rs_ui *ui, int id, rs_ui_rect r, float *dx, float *dy);
 
@@ -219,6 +223,8 @@ typedef struct rs_ui_texture {
 // Copies `src` (RGBA8, w x h) into dst, (re)allocating it to that size.
 rs_result rs_ui_texture_copy(rs_ui_texture *dst, GLuint src, int w, int h, rs_error *err);
 void rs_ui_texture_free(rs_ui_texture *t);
+// Uploads an RGB or RGBA image (rows top-first: draw it with uv {0, 0, 1, 1}) into dst, (re)allocating it.
+rs_result rs_ui_texture_upload(rs_ui_texture *dst, const rs_image *img, rs_error *err);
 // Reads the bound framebuffer's w x h pixels into a new RGBA image, rows top-first.
 rs_result rs_ui_read_pixels(int w, int h, rs_image *out, rs_error *err);
 

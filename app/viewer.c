@@ -35,7 +35,6 @@
 #define BUDGET_MS 40.0
 #define SETTLE_S 0.25
 #define SETTLE_FRAMES 3
-#define DEFAULT_LOOK "rouge.look"
 #define ORBIT_DEG_PER_PT 0.35f
 #define ZOOM_STEP 1.12f
 #define SIZE_MIN_REL 0.02f    // brush diameter / face height at the size slider's ends (log scale)
@@ -65,7 +64,7 @@ const vw_shortcut vw_shortcuts[] = {
     {"B", "before/after split"},
     {"I", "HUD: frame time, LOD"},
     {"S", "screenshot (rouge-NNNN.png)"},
-    {"Ctrl+S, Ctrl+O", "save / load the look"},
+    {"Ctrl+S, Ctrl+O", "save a look / the look library"},
     {"F11, Ctrl+Q", "full screen, quit"},
     {"H or ?, Esc", "help; Esc closes help/split"},
     {"Drop a .rsf file", "open another face"},
@@ -80,14 +79,17 @@ void rs_app_print_viewer_help(FILE *f)
                "  the help, then the split. The toolbar does all of it by touch: swatches pick a cosmetic (and\n"
                "  paint mode), the right rail holds the light dial (drag the sun: the light follows geared down,\n"
                "  120 points of drag from the centre to the rim), brush size (mm) and opacity (%%); drag the split's\n"
-               "  divider to compare. The look is saved to / loaded from --look FILE (default ./%s).\n"
+               "  divider to compare. Ctrl+S saves the look under a name in the look library (--looks DIR;\n"
+               "  see 'look library' below), Ctrl+O opens the library: tap a look to load it, its split icon to\n"
+               "  compare it with the current one side by side, its bin twice to delete it. --look FILE loads a\n"
+               "  look file at start.\n"
                "  While orbiting or painting a coarser LOD (then a lower resolution) keeps frames near %.0f ms;\n"
                "  the picture refines to full quality when idle.\n",
-            DEFAULT_LOOK, BUDGET_MS);
+            BUDGET_MS);
     fprintf(f,
             "\nevent scripts (rouge view --events FILE): one command per line, '#' comments, window coordinates\n"
             "  move X Y | down [left|right|middle] | up [BUTTON] | click X Y | drag X0 Y0 X1 Y1 [STEPS] [BUTTON]\n"
-            "  scroll DY | key NAME (p, [, ?, ctrl+z, shift+tab, f11, esc, ...) | touch ID down|move|up X Y\n"
+            "  scroll DY | key NAME (p, [, ?, ctrl+z, shift+tab, f11, esc, ...) | type TEXT | touch ID down|move|up X Y\n"
             "  drop FILE | step S (script clock per pointer event, default 1/60 s) | frames N | wait S\n"
             "  idle (until full quality) | screenshot FILE [X Y W H] (PNG of the window or a region, after\n"
             "  idle) | wait-for FILE (until FILE exists) | loaded (until the face file has loaded) | quit\n");
@@ -463,6 +465,7 @@ static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path
         rs_splat_destroy(cloud);
         return r;
     }
+    vw_looks_forget_face(v);
     face_close(v);
     v->cloud = cloud, v->ren = ren, v->mk = mk, v->paint = pt;
     // The pigment is clamped into this face's colour range, as `rouge render` does (rouge.c).
@@ -478,25 +481,15 @@ static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path
     return RS_OK;
 }
 
-static void save_look(vw_viewer *v)
+rs_result vw_load_look_file(vw_viewer *v, const char *path, rs_error *err)
 {
-    rs_error err = {0};
-    if (rs_look_save(v->mk, v->look_path, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
-    else vw_toast(v, false, "Saved look to %s", v->look_path);
-}
-
-// Loads the look file; a missing file is fine when quiet_if_missing (--look names where to save too).
-static rs_result load_look(vw_viewer *v, bool quiet_if_missing, rs_error *err)
-{
-    if (quiet_if_missing && access(v->look_path, F_OK) != 0) return RS_OK;
     rs_makeup_range d = {0, 0};
-    rs_result r = rs_look_load(v->mk, v->look_path, &d, err);
+    rs_result r = rs_look_load(v->mk, path, &d, err);
     if (r != RS_OK) {
         vw_toast(v, true, "%s", err->msg);
         return r;
     }
     upload(v, d);
-    vw_toast(v, false, "Loaded look %s", v->look_path);
     return RS_OK;
 }
 
@@ -550,6 +543,7 @@ static bool next_screenshot_name(vw_viewer *v, char *out, size_t n)
 
 static void key_action(vw_viewer *v, int key, int mods)
 {
+    if (vw_looks_key(v, key, mods)) return;  // the look library's sheet or dialog has the keyboard
     bool ctrl = mods & GLFW_MOD_CONTROL, shift = mods & GLFW_MOD_SHIFT;
     int n = (int)rs_cosmetic_count();
     switch (key) {
@@ -576,14 +570,11 @@ static void key_action(vw_viewer *v, int key, int mods)
         else if (v->split) v->split = false, v->dirty_view = true;
         break;
     case GLFW_KEY_S:
-        if (ctrl) save_look(v);
+        if (ctrl) vw_looks_begin_save(v);
         else v->want_face_shot = true;
         break;
     case GLFW_KEY_O:
-        if (ctrl) {
-            rs_error err = {0};
-            load_look(v, false, &err);
-        }
+        if (ctrl) vw_looks_open(v);
         break;
     case GLFW_KEY_Q: if (ctrl) v->quit = true; break;
     case GLFW_KEY_F11: toggle_fullscreen(v); break;
@@ -714,6 +705,7 @@ static void dispatch(vw_viewer *v)
             break;
         case VW_KEY: key_action(v, ev.key, ev.mods); break;
         case VW_TOUCH: feed_paint(v, ev.touch, 100 + ev.id, x, y, ev.time_s); break;
+        case VW_CHAR: vw_looks_char(v, (unsigned)ev.key); break;
         case VW_DROP: {
             rs_error err = {0};
             if (load_start(v, ev.path, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
@@ -757,6 +749,12 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     vw_viewer *v = glfwGetWindowUserPointer(w);
     if (action == GLFW_RELEASE || key == GLFW_KEY_UNKNOWN) return;
     vw_queue_push(&v->queue, &(vw_event){.type = VW_KEY, .time_s = glfwGetTime(), .key = key, .mods = mods});
+}
+
+static void on_char(GLFWwindow *w, unsigned int codepoint)
+{
+    vw_viewer *v = glfwGetWindowUserPointer(w);
+    vw_queue_push(&v->queue, &(vw_event){.type = VW_CHAR, .time_s = glfwGetTime(), .key = (int)codepoint});
 }
 
 static void on_drop(GLFWwindow *w, int count, const char **paths)
@@ -836,13 +834,19 @@ static rs_result render_scene(vw_viewer *v, rs_error *err)
     if (!v->dirty_view && !v->dirty_makeup && !quality_change) return RS_OK;
     apply_rung(v, want);
     rs_result r = RS_OK;
-    if (v->split && (v->dirty_view || quality_change || !v->before.tex)) {
-        v->view.hide_makeup = true;
-        r = rs_render_frame(v->ren, &v->view, err);
+    if (v->split && (v->dirty_view || quality_change || !v->before.tex || v->looks.compare_dirty)) {
+        // The left half: the bare face, or a look from the library to compare with.
+        if (vw_looks_comparing(v)) {
+            r = vw_looks_render_compared(v, err);
+        } else {
+            v->view.hide_makeup = true;
+            r = rs_render_frame(v->ren, &v->view, err);
+            v->view.hide_makeup = false;
+        }
+        v->looks.compare_dirty = false;
         int tw, th;
         GLuint tex = rs_render_output_texture(v->ren, &tw, &th);
         if (!r) r = rs_ui_texture_copy(&v->before, tex, tw, th, err);
-        v->view.hide_makeup = false;
     }
     if (!r) r = rs_render_frame(v->ren, &v->view, err);
     v->dirty_view = v->dirty_makeup = false;
@@ -869,8 +873,8 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
     case RS_UI_TOOL_PIPELINE: key_action(v, GLFW_KEY_R, 0); break;
     case RS_UI_TOOL_SPLIT: v->split = !v->split, v->dirty_view = true; break;
     case RS_UI_TOOL_HUD: v->hud = !v->hud; break;
-    case RS_UI_TOOL_SAVE: save_look(v); break;
-    case RS_UI_TOOL_LOAD: key_action(v, GLFW_KEY_O, GLFW_MOD_CONTROL); break;
+    case RS_UI_TOOL_SAVE: vw_looks_begin_save(v); break;
+    case RS_UI_TOOL_LOAD: vw_looks_open(v); break;
     case RS_UI_TOOL_SCREENSHOT: v->want_face_shot = true; break;
     case RS_UI_TOOL_HELP: v->help = !v->help; break;
     case RS_UI_TOOL_LIGHT:
@@ -960,7 +964,10 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
         return RS_OK;
     }
     if (!was_partial) reset_camera(v);
-    if (l->initial && v->cli->look && (r = load_look(v, true, err))) return r;
+    if (l->initial && v->cli->look) {
+        if ((r = vw_load_look_file(v, v->cli->look, err))) return r;
+        vw_toast(v, false, "Loaded look %s", v->cli->look);
+    }
     if (!l->initial) vw_toast(v, false, "Opened %s", l->path);
     return RS_OK;
 }
@@ -1092,6 +1099,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         glfwSetScrollCallback(v->win, on_scroll);
         glfwSetKeyCallback(v->win, on_key);
         glfwSetDropCallback(v->win, on_drop);
+        glfwSetCharCallback(v->win, on_char);
         glfwSetWindowRefreshCallback(v->win, on_refresh);
         glfwSetCursorEnterCallback(v->win, on_enter);
         v->picker = (rs_paint_picker){.user = v, .pick = vw_pick, .pixels_per_unit = vw_pixels_per_unit, .view_dir = view_dir_cb};
@@ -1102,7 +1110,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         v->hud = true;
         v->last_input_s = -1e9;
         v->last_input_frame = -1000;
-        snprintf(v->look_path, sizeof v->look_path, "%s", cli->look ? cli->look : DEFAULT_LOOK);
+        vw_looks_init(v);
         dial_from_light(v);
         select_cosmetic(v, 0);
         v->paint_mode = false;
@@ -1118,6 +1126,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         if (!r && r2) r = r2, *err = e2;
     }
     load_abort(v);
+    vw_looks_free(v);
     face_close(v);
     rs_env_destroy(v->env_cpu);
     rs_ui_texture_free(&v->before);

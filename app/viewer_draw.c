@@ -38,12 +38,13 @@ void vw_draw_picture(vw_viewer *v, rs_ui *ui)
     }
 }
 
-// The before/after divider: a line with a round handle low on the picture (clear of the lips and eyes),
-// "Before" and "After" on either side of the handle.
-static void draw_split_divider(vw_viewer *v)
+// The before/after divider: a line with a round handle just above the swatch sheet (on the picture's
+// bottom edge, clear of the lips and eyes at any zoom; at 72 % of the height it once sat on the lips),
+// "Before" and "After" (or the compared look's name and "Current") on either side of the handle.
+static void draw_split_divider(vw_viewer *v, const rs_ui_toolbar_layout *l)
 {
-    float s = v->ui_scale, sx = floorf(v->split_frac * (float)v->fb_w);
-    float hy = floorf((float)v->fb_h * 0.72f), hr = 22 * s;
+    float s = v->ui_scale, sx = floorf(v->split_frac * (float)v->fb_w), hr = 22 * s;
+    float hy = floorf(l->bottom.y - hr - 14 * s);
     rs_ui_line(v->ui, sx, 0, sx, (float)v->fb_h, 2.5f * s, (rs_ui_rgba){255, 255, 255, 220});
     float dx, dy;
     // The whole line is draggable, the handle just shows where.
@@ -55,15 +56,17 @@ static void draw_split_divider(vw_viewer *v)
     rs_ui_icon_draw(v->ui, RS_UI_ICON_CHEVRONS, (rs_ui_rect){sx - hr * 0.6f, hy - hr * 0.6f, hr * 1.2f, hr * 1.2f},
                     (rs_ui_rgba){40, 40, 48, 255});
     int ts = RS_MAX(1, (int)(s * 2 + 0.25f));
-    const char *l = "Before", *r = "After";
-    float lw = rs_ui_text_width(l, ts), rw = rs_ui_text_width(r, ts), th = 7.0f * (float)ts;
+    // Left: the bare face, or the look from the library being compared; right: the look being painted.
+    bool cmp = vw_looks_comparing(v);
+    const char *left = cmp ? v->looks.compare : "Before", *right = cmp ? "Current" : "After";
+    float lw = rs_ui_text_width(left, ts), rw = rs_ui_text_width(right, ts), th = 7.0f * (float)ts;
     float ph = th + 14 * s, py = hy - ph * 0.5f;
     rs_ui_rect lr = {sx - hr - 10 * s - lw - 20 * s, py, lw + 20 * s, ph};
     rs_ui_rect rr = {sx + hr + 10 * s, py, rw + 20 * s, ph};
     rs_ui_fill(v->ui, lr, ph * 0.5f, RS_UI_PANEL);
-    rs_ui_text(v->ui, lr.x + 10 * s, py + (ph - th) * 0.5f, ts, RS_UI_WHITE, l);
+    rs_ui_text(v->ui, lr.x + 10 * s, py + (ph - th) * 0.5f, ts, RS_UI_WHITE, left);
     rs_ui_fill(v->ui, rr, ph * 0.5f, RS_UI_PANEL);
-    rs_ui_text(v->ui, rr.x + 10 * s, py + (ph - th) * 0.5f, ts, RS_UI_WHITE, r);
+    rs_ui_text(v->ui, rr.x + 10 * s, py + (ph - th) * 0.5f, ts, RS_UI_WHITE, right);
 }
 
 // The brush ring: the brush's footprint on the face under the cursor (its size at that depth).
@@ -226,7 +229,15 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         return RS_UI_TOOL_NONE;
     }
     if (v->load.running) draw_loading(v);
-    if (v->split) draw_split_divider(v);
+    // The look library's sheet and dialog are modal: the toolbar steps aside while they are up.
+    if (vw_looks_modal(v)) {
+        *st = (rs_ui_toolbar_state){0};
+        vw_looks_draw(v);
+        rs_ui_toolbar_layout l;
+        rs_ui_toolbar_layout_compute(v->fb_w, v->fb_h, v->ui_scale, (int)rs_cosmetic_count(), &l);
+        draw_toast(v, &l);
+        return RS_UI_TOOL_NONE;
+    }
     draw_brush_ring(v);
 
     // Swatches and names live in the viewer (static storage would be a hidden global).
@@ -239,6 +250,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
     }
     rs_ui_toolbar_layout l;
     rs_ui_toolbar_layout_compute(v->fb_w, v->fb_h, v->ui_scale, n, &l);
+    if (v->split) draw_split_divider(v, &l);
     // The brush as a person measures it: its diameter on the face in mm, and its opacity in percent.
     const rs_splat_header *h = &v->cloud->hdr;
     snprintf(v->size_text, sizeof v->size_text, "%.0f mm", v->size_rel * h->face_height * h->mm_per_unit);

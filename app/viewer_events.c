@@ -197,6 +197,17 @@ static rs_result parse_line(parser *p, char **tok, int n)
             return rs_fail(err, RS_ERR_FORMAT, "%s:%d: key: unknown key '%s'", p->file, p->line, tok[1]);
         return add_event(p, (vw_event){.type = VW_KEY, .key = key, .mods = mods}, true);
     }
+    if (!strcmp(c, "type")) {
+        // The rest of the line (words joined by single spaces), one character event each.
+        if (n < 2) return BAD("expected TEXT");
+        rs_result r = RS_OK;
+        for (int k = 1; k < n && !r; k++) {
+            if (k > 1) r = add_event(p, (vw_event){.type = VW_CHAR, .key = ' '}, false);
+            for (const char *q = tok[k]; *q && !r; q++)
+                r = add_event(p, (vw_event){.type = VW_CHAR, .key = (unsigned char)*q}, false);
+        }
+        return r;
+    }
     if (!strcmp(c, "touch")) {
         if (n != 5 || !rs_parse_number(tok[1], 1, 9, &a[0]) || a[0] != floor(a[0])) return BAD("expected ID (1..9) down|move|up X Y");
         rs_input_type t;

@@ -4,6 +4,7 @@
 // viewer.c          the window, frame loop, input routing, actions, adaptive quality, face loading
 // viewer_draw.c     the picture, toolbar, split divider, brush ring, HUD, toasts, help, screenshots
 // viewer_events.c   the event queue and the event script (parser + player)
+// viewer_looks.c    the look library sheet, the save dialog and the split's compared look
 #ifndef RS_APP_VIEWER_INTERNAL_H
 #define RS_APP_VIEWER_INTERNAL_H
 
@@ -13,6 +14,7 @@
 #include "makeup/makeup.h"
 #include "paint/paint.h"
 #include "render/render.h"
+#include "formats/looklib.h"
 #include "formats/strokes.h"
 #include "ui.h"
 #include "window.h"
@@ -32,6 +34,7 @@ typedef enum vw_event_type {
     VW_KEY,        // key press: GLFW key code + GLFW modifier bits
     VW_TOUCH,      // touch pointer `id` down/move/up at x, y
     VW_DROP,       // a file dropped on the window
+    VW_CHAR,       // a character typed (Unicode code point in `key`): text fields
 } vw_event_type;
 
 typedef struct vw_event {
@@ -72,6 +75,7 @@ bool vw_queue_peek(const vw_queue *q, vw_event *ev);
 //                               enter, left, right, up, down, delete, backspace, home; prefixes ctrl+,
 //                               shift+, alt+ (ctrl+z, shift+[)
 //   touch ID down|move|up X Y   touch pointer ID (1..9): two of them pinch and pan
+//   type TEXT                   characters typed (a text field: the look library's save dialog)
 //   drop FILE                   as if FILE was dropped on the window
 //   step S                      script clock advance per pointer event (default 1/60 s)
 //   frames N                    let N frames run
@@ -162,6 +166,35 @@ typedef struct vw_loader {
     uint32_t decoded, count;      // progress for the loading line (splats)
 } vw_loader;
 
+// The look library (viewer_looks.c).
+#define VW_LOOKS_PAGE_MAX 32  // cards on one page of the sheet
+
+// Where the sheet and the save dialog put things (pure: vw_looks_layout), framebuffer pixels.
+typedef struct vw_looks_sheet_layout {
+    rs_ui_rect sheet, title, save, bare, close, prev, next, folder;
+    int cols, rows, per_page;
+    rs_ui_rect card[VW_LOOKS_PAGE_MAX];  // thumbnails (the name below, compare and delete on the top right)
+    rs_ui_rect dialog, field, ok, cancel;
+} vw_looks_sheet_layout;
+
+typedef struct vw_looks {
+    char dir[1024];             // the library: --looks or the XDG default ("" when neither could be set)
+    bool open;                  // the sheet is shown
+    bool saving;                // the save dialog is shown
+    bool clash;                 // the dialog's name is taken: it asks before overwriting
+    bool back_to_sheet;         // the dialog was opened from the sheet (and returns there)
+    char name[RS_LOOKLIB_NAME_MAX + 1];  // the name being typed
+    rs_looklib_entry *entries;  // newest first
+    uint32_t count;
+    int page, selected, per_page, cols;
+    int confirm_delete;         // the entry whose delete waits for a second tap, -1 none
+    rs_ui_texture thumb[VW_LOOKS_PAGE_MAX];
+    int thumb_page;             // the page those textures show, -1 none
+    char compare[RS_LOOKLIB_NAME_MAX + 1];  // the look in the split's left half; "" = the bare face
+    rs_makeup *cmp;             // its layer (on the face's cloud)
+    bool compare_dirty;         // the left half must be rendered again
+} vw_looks;
+
 // One step of the adaptive quality ladder: the LOD prefix drawn and the render resolution.
 typedef struct vw_rung {
     uint32_t max_splats;
@@ -235,9 +268,9 @@ typedef struct vw_viewer {
     bool rendered_this_frame;
 
     // Files.
+    vw_looks looks;
     rs_strokes *rec;
     bool rec_unsaved;           // strokes recorded since the file was last written (saved when idle)
-    char look_path[512];
     int shot_counter;
     char toast[256];
     bool toast_error;
@@ -268,6 +301,25 @@ const char *vw_brush_region(const vw_viewer *v);
 // The picker on the picture as shown: framebuffer pixels in, whatever resolution it was rendered at.
 bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index, float hit[3]);
 float vw_pixels_per_unit(void *viewer, const float pos[3]);
+
+// Loads a look file into the face (undo history restarts), uploads it; toasts and returns failures.
+rs_result vw_load_look_file(vw_viewer *v, const char *path, rs_error *err);
+
+// viewer_looks.c
+void vw_looks_layout(int fb_w, int fb_h, float scale, vw_looks_sheet_layout *out);
+void vw_looks_init(vw_viewer *v);
+void vw_looks_free(vw_viewer *v);
+void vw_looks_open(vw_viewer *v);           // Ctrl+O, the top bar's folder
+void vw_looks_begin_save(vw_viewer *v);     // Ctrl+S, the top bar's save
+bool vw_looks_modal(const vw_viewer *v);    // the sheet or the dialog is up: the toolbar steps aside
+bool vw_looks_key(vw_viewer *v, int key, int mods);  // true when the sheet/dialog took the key
+void vw_looks_char(vw_viewer *v, unsigned codepoint);
+void vw_looks_draw(vw_viewer *v);           // into v->ui, after the rest; handles its taps
+void vw_looks_forget_face(vw_viewer *v);    // another face was opened
+bool vw_looks_comparing(const vw_viewer *v);
+// Renders the view with the compared look into the renderer's output (the split's left half), then
+// puts the current look back on the GPU.
+rs_result vw_looks_render_compared(vw_viewer *v, rs_error *err);
 
 // viewer_draw.c
 // The rendered picture (and the split's bare half) filling the window, into `ui`'s list.

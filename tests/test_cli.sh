@@ -131,3 +131,40 @@ expect cli_no_gles3_is_one_clear_line 1 "no GLES 3 context" \
 no_file cli_no_gles3_leaves_no_output "$tmp/f.png"
 expect cli_render_small 0 "" "$rouge" render "$face" -o "$tmp/g.png" --size 64x64 --max-splats 5000
 if [ -s "$tmp/g.png" ]; then echo "ok - cli_render_writes_png"; else echo "FAIL - cli_render_writes_png: no file"; fi
+# The look library (issue 15): save, list, path, rm through `rouge looks`; a name in use is refused unless
+# --force; bad names, non-look files and unknown looks get one line and exit 2 (1 for a bad file), and
+# nothing lands in the library.
+lib="$tmp/lib"
+"$rouge" render "$face" -o "$tmp/lk.png" --size 32x32 --max-splats 2000 --strokes tests/fixtures/strokes/lips.strokes \
+    --save-look "$tmp/lips.look" >/dev/null 2>&1
+expect cli_looks_save 0 "" "$rouge" looks save "Red lips" --look "$tmp/lips.look" --looks "$lib"
+if [ -s "$lib/Red lips.look" ] && [ -s "$lib/Red lips.png" ] && cmp -s "$lib/Red lips.look" "$tmp/lips.look"; then
+    echo "ok - cli_looks_save_writes_look_and_thumbnail"
+else echo "FAIL - cli_looks_save_writes_look_and_thumbnail: $(ls "$lib" 2>&1 | tr '\n' ' ')"; fi
+printf 'rouge-look 1\nface height=4.7\n' >"$tmp/empty.look"
+expect cli_looks_save_clash_refused 2 "already in the library (--force replaces it)" \
+    "$rouge" looks save "Red lips" --look "$tmp/empty.look" --looks "$lib"
+if cmp -s "$lib/Red lips.look" "$tmp/lips.look"; then echo "ok - cli_looks_clash_keeps_the_look"
+else echo "FAIL - cli_looks_clash_keeps_the_look: the look was replaced"; fi
+expect cli_looks_save_force 0 "" "$rouge" looks save "Red lips" --look "$tmp/empty.look" --looks "$lib" --force --no-thumbnail
+if cmp -s "$lib/Red lips.look" "$tmp/empty.look" && [ ! -e "$lib/Red lips.png" ]; then echo "ok - cli_looks_force_replaces"
+else echo "FAIL - cli_looks_force_replaces: $(ls "$lib" | tr '\n' ' ')"; fi
+expect cli_looks_bad_name_slash 2 "look name: '/' not allowed" "$rouge" looks save "a/b" --look "$tmp/lips.look" --looks "$lib"
+expect cli_looks_bad_name_dots 2 "look name: '.' not allowed" "$rouge" looks save ".." --look "$tmp/lips.look" --looks "$lib"
+expect cli_looks_bad_name_long 2 "at most 40" "$rouge" looks save 12345678901234567890123456789012345678901 \
+    --look "$tmp/lips.look" --looks "$lib"
+expect cli_looks_bad_name_control 2 "byte 0x1b" "$rouge" looks save "$(printf 'x\033y')" --look "$tmp/lips.look" --looks "$lib"
+expect cli_looks_not_a_look 1 "lk.png: line 1: not a look file" "$rouge" looks save pic --look "$tmp/lk.png" --looks "$lib"
+expect cli_looks_missing_look_file 1 "cannot open" "$rouge" looks save pic --look "$tmp/none.look" --looks "$lib"
+expect cli_looks_unknown_verb 2 "unknown command 'export'" "$rouge" looks export x --looks "$lib"
+expect cli_looks_save_needs_look 2 "needs --look FILE" "$rouge" looks save x --looks "$lib"
+if [ "$(ls "$lib" | wc -l)" = 1 ]; then echo "ok - cli_looks_refusals_leave_nothing"
+else echo "FAIL - cli_looks_refusals_leave_nothing: $(ls -A "$lib" | tr '\n' ' ')"; fi
+expect cli_looks_list 0 "" "$rouge" looks list --looks "$lib"
+if grep -q "^Red lips " "$tmp/out"; then echo "ok - cli_looks_list_names_the_look"; else echo "FAIL - cli_looks_list_names_the_look: $(cat "$tmp/out")"; fi
+expect cli_looks_path 0 "" "$rouge" looks path "Red lips" --looks "$lib"
+if [ "$(cat "$tmp/out")" = "$lib/Red lips.look" ]; then echo "ok - cli_looks_path_prints_the_file"
+else echo "FAIL - cli_looks_path_prints_the_file: $(cat "$tmp/out")"; fi
+expect cli_looks_rm 0 "" "$rouge" looks rm "Red lips" --looks "$lib"
+expect cli_looks_rm_unknown 2 "no look named 'Red lips'" "$rouge" looks rm "Red lips" --looks "$lib"
+expect cli_looks_list_empty 0 "no looks in" "$rouge" looks list --looks "$lib"

@@ -29,7 +29,8 @@ viewer_xdotool_stroke_changes_only_the_painted_area viewer_bad_face_exits_with_o
 viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
 viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file
 viewer_streamed_face_draws_the_first_level_before_the_rest viewer_stdin_not_a_face_exits_with_one_line
-viewer_and_rouge_render_show_the_same_look viewer_region_brush_keeps_lipstick_on_the_lips"
+viewer_and_rouge_render_show_the_same_look viewer_region_brush_keeps_lipstick_on_the_lips
+viewer_look_library_saves_refuses_clashes_loads_compares_deletes"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -57,8 +58,9 @@ IN="330 105 140 90"
 OUT1="80 260 630 150"
 OUT2="80 80 220 170"
 OUT3="500 80 210 170"
+# Every run keeps its looks in the test's own library (never the user's ~/.local/share/rouge/looks).
 view() {
-    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 "$@"
+    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/looks" "$@"
 }
 
 # shots PREFIX: screenshot commands for the in/out regions (the pointer parked on the swatch sheet, so
@@ -104,7 +106,7 @@ check_stroke() {
 
 if selected viewer_script_stroke_changes_only_the_painted_area || selected viewer_undo_restores_the_picture_exactly ||
     selected viewer_look_saved_and_loaded_renders_the_same || selected viewer_records_a_replayable_stroke_file; then
-    rm -f "$out/test.look" "$out/rec.strokes"
+    rm -rf "$out/rec.strokes" "$out/looks"
     {
         echo "key i"          # HUD off: its numbers change from frame to frame
         shots before
@@ -115,14 +117,16 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
         shots after
         echo "key ctrl+z"
         shots undone
-        echo "key ctrl+y"     # redo, then save the look, clear everything and load it back
+        echo "key ctrl+y"     # redo, then save the look (as "Look 1"), clear everything and load it back
         echo "key ctrl+s"
+        echo "key enter"
         echo "key delete"
         echo "key ctrl+o"
+        echo "key enter"      # the library's newest look
         shots reloaded
         echo "quit"
     } >"$out/stroke.events"
-    view --events "$out/stroke.events" --look "$out/test.look" --record "$out/rec.strokes" >"$out/script.log" 2>&1
+    view --events "$out/stroke.events" --record "$out/rec.strokes" >"$out/script.log" 2>&1
     rc=$?
     if selected viewer_script_stroke_changes_only_the_painted_area; then
         if [ $rc -ne 0 ]; then echo "FAIL - viewer_script_stroke_changes_only_the_painted_area: exit $rc: $(tail -c 300 "$out/script.log")"
@@ -136,7 +140,7 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
     fi
     if selected viewer_look_saved_and_loaded_renders_the_same; then
         name=viewer_look_saved_and_loaded_renders_the_same
-        if [ ! -s "$out/test.look" ]; then echo "FAIL - $name: no look file written (exit $rc)"
+        if [ ! -s "$out/looks/Look 1.look" ]; then echo "FAIL - $name: no look saved in the library (exit $rc)"
         elif [ ! -f "$out/reloaded_mid.png" ]; then echo "FAIL - $name: no screenshot (exit $rc)"
         elif why=$(region_same after reloaded mid); then echo "ok - $name"
         else echo "FAIL - $name: $why ($out/after_mid.png vs reloaded_mid.png)"; fi
@@ -393,6 +397,69 @@ if selected viewer_region_brush_keeps_lipstick_on_the_lips; then
     if [ $rc -ne 0 ] || [ ! -f "$out/kfree_mid.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/region.log")"
     elif ! why=$(region_same kbefore kmasked in mid); then echo "FAIL - $name: lipstick painted the forehead: $why"
     elif ! region_changed kmasked kfree; then echo "FAIL - $name: with K the stroke did not paint"
+    else echo "ok - $name"; fi
+fi
+if selected viewer_look_library_saves_refuses_clashes_loads_compares_deletes; then
+    # The look library (issue 15) through the window: Ctrl+S saves under a typed name; saving the bare face
+    # under the same name is refused by Enter (the dialog asks to overwrite), so loading it (Ctrl+O, Enter:
+    # the newest look) brings the painted picture back; C compares it in the split (left of the divider the
+    # saved look, right the current bare face); the card's bin, tapped twice, deletes it. The sheet at
+    # 800x600 (vw_looks_layout, scale 1): first card at (56, 88) 160x120, its bin at (172, 92) 40x40.
+    name=viewer_look_library_saves_refuses_clashes_loads_compares_deletes
+    lib="$out/looks"
+    rm -rf "$lib"
+    halves() {
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $out/$1_left.png 330 105 60 90"
+        echo "screenshot $out/$1_right.png 412 105 58 90"
+    }
+    {
+        echo "key i"
+        echo "key p"
+        echo "key 9"
+        echo "key k"                    # lipstick anywhere: a strong mark across the forehead
+        echo "drag 340 150 460 150 40"
+        shots lpainted
+        halves lpainted
+        echo "key ctrl+s"
+        for i in 1 2 3 4 5 6; do echo "key backspace"; done   # the default "Look 1" goes
+        echo "type Forehead red"
+        echo "key enter"
+        echo "key delete"               # bare again
+        shots lbare
+        halves lbare
+        echo "key ctrl+s"
+        for i in 1 2 3 4 5 6; do echo "key backspace"; done
+        echo "type Forehead red"
+        echo "key enter"                # the name is taken: Enter does not overwrite
+        echo "key esc"
+        echo "key ctrl+o"
+        echo "key enter"                # load the newest look
+        shots lloaded
+        echo "key delete"
+        echo "key ctrl+o"
+        echo "key c"                    # compare it with the (bare) current look
+        halves lcompare
+        echo "screenshot $out/lcompare_all.png"
+        echo "key ctrl+o"
+        echo "idle"
+        echo "screenshot $out/lsheet.png"
+        echo "click 192 112"            # the bin: asks
+        echo "click 192 112"            # ... deletes
+        echo "key esc"
+        echo "quit"
+    } >"$out/library.events"
+    view --events "$out/library.events" >"$out/library.log" 2>&1
+    rc=$?
+    if [ $rc -ne 0 ] || [ ! -f "$out/lsheet.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/library.log")"
+    elif ! region_changed lbare lpainted; then echo "FAIL - $name: the stroke did not paint"
+    elif ! why=$(region_same lpainted lloaded in mid); then echo "FAIL - $name: the loaded look differs (overwritten?): $why"
+    elif ! why=$(region_same lpainted lcompare left); then echo "FAIL - $name: the split's left half is not the saved look: $why"
+    elif ! why=$(region_same lbare lcompare right); then echo "FAIL - $name: the split's right half is not the current look: $why"
+    elif [ -e "$lib/Forehead red.look" ] || [ -e "$lib/Forehead red.png" ]; then
+        echo "FAIL - $name: the bin did not delete the look ($(ls "$lib" | tr '\n' ' '))"
+    elif [ -n "$(ls -A "$lib")" ]; then echo "FAIL - $name: files left in the library: $(ls -A "$lib" | tr '\n' ' ')"
     else echo "ok - $name"; fi
 fi
 if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
