@@ -57,6 +57,7 @@ const vw_shortcut vw_shortcuts[] = {
     {"[ ], Shift+[ ]", "brush size, opacity"},
     {"E, M", "eraser, mirror painting"},
     {"K", "keep the brush to its region"},
+    {"C", "product editor: colour, finish, coverage"},
     {"Ctrl+Z, Ctrl+Y", "undo, redo"},
     {"Delete", "clear all makeup"},
     {"A, D, F", "albedo / diffuse / full"},
@@ -153,10 +154,10 @@ static void view_dir_cb(void *user, const float pos[3], float dir[3])
 
 // --- brush and view state -----------------------------------------------------------------------------
 
-static void apply_brush(vw_viewer *v)
+void vw_apply_brush(vw_viewer *v)
 {
     if (!v->paint) return;
-    rs_paint_brush b = {.cosmetic = *rs_cosmetic_get((uint32_t)v->cosmetic), .size_rel = v->size_rel,
+    rs_paint_brush b = {.cosmetic = *vw_current_cosmetic(v), .size_rel = v->size_rel,
                         .opacity = v->opacity, .pressure = RS_MAKEUP_PRESSURE_FLOOR, .eraser = v->eraser,
                         .mirror = v->mirror, .any_region = v->any_region};
     rs_paint_set_brush(v->paint, &b);
@@ -167,7 +168,7 @@ static void apply_brush(vw_viewer *v)
 // Where the current product's brush stays ("lips"), NULL when it paints anywhere.
 const char *vw_brush_region(const vw_viewer *v)
 {
-    rs_cosmetic_region r = rs_cosmetic_region_of(rs_cosmetic_get((uint32_t)v->cosmetic));
+    rs_cosmetic_region r = rs_cosmetic_region_of(vw_current_cosmetic(v));
     if (v->any_region || r == RS_COSMETIC_REGION_ANY) return NULL;
     return rs_cosmetic_region_name(r);
 }
@@ -175,7 +176,7 @@ const char *vw_brush_region(const vw_viewer *v)
 static void toggle_region(vw_viewer *v)
 {
     v->any_region = !v->any_region;
-    apply_brush(v);
+    vw_apply_brush(v);
     const char *r = vw_brush_region(v);
     if (r) vw_toast(v, false, "Brush keeps to the %s (K: anywhere)", r);
     else vw_toast(v, false, "Brush paints anywhere (K: keep to the product's region)");
@@ -185,13 +186,15 @@ static void select_cosmetic(vw_viewer *v, int i)
 {
     int n = (int)rs_cosmetic_count();
     v->cosmetic = ((i % n) + n) % n;
+    v->editor.custom = false;  // a preset picked: the editor shows it until edited
+    vw_editor_sync(v);
     const rs_cosmetic *c = rs_cosmetic_get((uint32_t)v->cosmetic);
     // A product comes with its own brush (a liner is fine, a foundation broad), as in mobile makeup apps.
     v->size_rel = RS_CLAMP(c->size_rel, SIZE_MIN_REL, SIZE_MAX_REL);
     v->opacity = c->opacity;
     v->eraser = false;
     v->paint_mode = true;
-    apply_brush(v);
+    vw_apply_brush(v);
 }
 
 static bool env_lit(const vw_viewer *v) { return v->view.lighting == RS_LIGHTING_ENV && v->env_cpu; }
@@ -473,7 +476,7 @@ static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path
     rs_makeup_get_uniforms(mk, &mu);
     rs_render_set_makeup_uniforms(ren, &mu);
     snprintf(v->face_path, sizeof v->face_path, "%s", path);
-    apply_brush(v);
+    vw_apply_brush(v);
     if (v->rec) rs_paint_set_recorder(v->paint, v->rec, NULL);
     build_rungs(v);
     v->rendered_full = false;
@@ -544,12 +547,14 @@ static bool next_screenshot_name(vw_viewer *v, char *out, size_t n)
 static void key_action(vw_viewer *v, int key, int mods)
 {
     if (vw_looks_key(v, key, mods)) return;  // the look library's sheet or dialog has the keyboard
+    if (vw_editor_key(v, key, mods)) return;  // the product editor's keys (X, N, comma, period, Esc)
     bool ctrl = mods & GLFW_MOD_CONTROL, shift = mods & GLFW_MOD_SHIFT;
     int n = (int)rs_cosmetic_count();
     switch (key) {
-    case GLFW_KEY_P: v->paint_mode = !v->paint_mode, apply_brush(v); break;
-    case GLFW_KEY_E: v->eraser = !v->eraser, v->paint_mode = true, apply_brush(v); break;
-    case GLFW_KEY_M: v->mirror = !v->mirror, apply_brush(v); break;
+    case GLFW_KEY_C: vw_editor_toggle(v); break;
+    case GLFW_KEY_P: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
+    case GLFW_KEY_E: v->eraser = !v->eraser, v->paint_mode = true, vw_apply_brush(v); break;
+    case GLFW_KEY_M: v->mirror = !v->mirror, vw_apply_brush(v); break;
     case GLFW_KEY_K: toggle_region(v); break;
     case GLFW_KEY_Z: if (ctrl) do_undo(v, shift); break;
     case GLFW_KEY_Y: if (ctrl) do_undo(v, true); break;
@@ -584,7 +589,7 @@ static void key_action(vw_viewer *v, int key, int mods)
         float d = key == GLFW_KEY_LEFT_BRACKET ? -0.08f : 0.08f;
         if (shift) v->opacity = RS_CLAMP(v->opacity + d, 0.05f, 1.0f);
         else v->size_rel = slider_to_size(RS_CLAMP(vw_size_to_slider(v->size_rel) + d, 0.0f, 1.0f));
-        apply_brush(v);
+        vw_apply_brush(v);
         break;
     }
     case GLFW_KEY_LEFT: orbit(v, -40 * v->px_per_pt, 0), mark_input(v); break;
@@ -705,7 +710,9 @@ static void dispatch(vw_viewer *v)
             break;
         case VW_KEY: key_action(v, ev.key, ev.mods); break;
         case VW_TOUCH: feed_paint(v, ev.touch, 100 + ev.id, x, y, ev.time_s); break;
-        case VW_CHAR: vw_looks_char(v, (unsigned)ev.key); break;
+        case VW_CHAR:
+            if (!vw_editor_char(v, (unsigned)ev.key)) vw_looks_char(v, (unsigned)ev.key);
+            break;
         case VW_DROP: {
             rs_error err = {0};
             if (load_start(v, ev.path, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
@@ -860,9 +867,9 @@ static rs_result render_scene(vw_viewer *v, rs_error *err)
 static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st, int sw)
 {
     switch (t) {
-    case RS_UI_TOOL_PAINT: v->paint_mode = !v->paint_mode, apply_brush(v); break;
-    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->paint_mode = true, apply_brush(v); break;
-    case RS_UI_TOOL_MIRROR: v->mirror = !v->mirror, apply_brush(v); break;
+    case RS_UI_TOOL_PAINT: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
+    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->paint_mode = true, vw_apply_brush(v); break;
+    case RS_UI_TOOL_MIRROR: v->mirror = !v->mirror, vw_apply_brush(v); break;
     case RS_UI_TOOL_REGION: toggle_region(v); break;
     case RS_UI_TOOL_UNDO: do_undo(v, false); break;
     case RS_UI_TOOL_REDO: do_undo(v, true); break;
@@ -882,8 +889,8 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
         light_from_dial(v);
         mark_input(v);
         break;
-    case RS_UI_TOOL_SIZE: v->size_rel = slider_to_size(st->size), apply_brush(v); break;
-    case RS_UI_TOOL_OPACITY: v->opacity = RS_CLAMP(st->opacity, 0.02f, 1.0f), apply_brush(v); break;
+    case RS_UI_TOOL_SIZE: v->size_rel = slider_to_size(st->size), vw_apply_brush(v); break;
+    case RS_UI_TOOL_OPACITY: v->opacity = RS_CLAMP(st->opacity, 0.02f, 1.0f), vw_apply_brush(v); break;
     case RS_UI_TOOL_SWATCH: if (sw >= 0) select_cosmetic(v, sw); break;
     case RS_UI_TOOL_NONE:
     case RS_UI_TOOL_COUNT: break;
@@ -948,7 +955,7 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
         if (p && face_open(v, p, l->path, &e) == RS_OK) {
             if (!v->partial) reset_camera(v);
             v->partial = true;
-            apply_brush(v);
+            vw_apply_brush(v);
         }
     }
     if (!load_finished(v)) return RS_OK;
@@ -957,7 +964,7 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
     if (!r) r = face_open(v, l->cloud, l->path, &l->err);
     l->cloud = NULL;
     v->partial = false;  // on failure a preview stays: all there is of that file
-    if (v->paint) apply_brush(v);
+    if (v->paint) vw_apply_brush(v);
     if (r) {
         if (l->initial) return rs_fail(err, r, "%s", l->err.msg);
         vw_toast(v, true, "%s", l->err.msg);

@@ -248,6 +248,12 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         display_name(c->name, v->swatch_names[i], sizeof v->swatch_names[i]);
         v->swatch_name_ptr[i] = v->swatch_names[i];
     }
+    // A custom product shows in its preset's place (the ring stays there; tapping it brings the preset back).
+    if (v->editor.custom && v->cosmetic < n) {
+        memcpy(v->swatch_rgb[v->cosmetic], v->editor.product.rgb, 3);
+        snprintf(v->swatch_names[v->cosmetic], sizeof v->swatch_names[0], "Custom %s",
+                 rs_cosmetic_kind_name(v->editor.product.kind));
+    }
     rs_ui_toolbar_layout l;
     rs_ui_toolbar_layout_compute(v->fb_w, v->fb_h, v->ui_scale, n, &l);
     if (v->split) draw_split_divider(v, &l);
@@ -268,6 +274,12 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         .mobile = v->view.pipeline == RS_PIPELINE_MOBILE,
     };
     rs_ui_tool t = rs_ui_toolbar(v->ui, &l, st, swatch);
+    // The product editor's chip at the swatch row's top right, and the editor when open.
+    float s = v->ui_scale;
+    rs_ui_rect chip = {l.bottom.x + l.bottom.w - 96 * s, l.bottom.y + 6 * s, 86 * s, 26 * s};
+    if (rs_ui_text_button(v->ui, 5190, chip, v->editor.custom ? "Custom" : "Edit", v->editor.open))
+        vw_editor_toggle(v);
+    vw_editor_draw(v, &l);
     draw_env_chips(v, &l);
     draw_hud(v, &l);
     draw_toast(v, &l);

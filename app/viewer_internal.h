@@ -4,6 +4,7 @@
 // viewer.c          the window, frame loop, input routing, actions, adaptive quality, face loading
 // viewer_draw.c     the picture, toolbar, split divider, brush ring, HUD, toasts, help, screenshots
 // viewer_events.c   the event queue and the event script (parser + player)
+// viewer_editor.c   the product editor (custom colour, finish, coverage)
 // viewer_looks.c    the look library sheet, the save dialog and the split's compared look
 #ifndef RS_APP_VIEWER_INTERNAL_H
 #define RS_APP_VIEWER_INTERNAL_H
@@ -201,6 +202,22 @@ typedef struct vw_rung {
     float scale;  // render pixels per framebuffer pixel (dynamic resolution)
 } vw_rung;
 
+// The product editor (viewer_editor.c): a custom product derived from the selected preset.
+typedef struct vw_editor {
+    bool open;
+    bool custom;            // the brush paints `product` instead of the selected preset
+    rs_cosmetic product;    // what the editor shows and edits
+    float hsv[3];           // hue (degrees), saturation, value of product.rgb (kept: greys have no hue)
+    bool hex_entry;         // typing a colour as six hex digits (X, or a tap on the hex field)
+    char hex[8];
+    int hex_len;
+} vw_editor;
+
+// Where the editor puts things (pure, for tests), framebuffer pixels.
+typedef struct vw_editor_layout {
+    rs_ui_rect panel, close, sv, hue, swatch, hex, finish[RS_FINISH_COUNT], coverage;
+} vw_editor_layout;
+
 typedef struct vw_viewer {
     const rs_cli *cli;
     rs_window *window;
@@ -269,6 +286,7 @@ typedef struct vw_viewer {
 
     // Files.
     vw_looks looks;
+    vw_editor editor;
     rs_strokes *rec;
     bool rec_unsaved;           // strokes recorded since the file was last written (saved when idle)
     int shot_counter;
@@ -320,6 +338,18 @@ bool vw_looks_comparing(const vw_viewer *v);
 // Renders the view with the compared look into the renderer's output (the split's left half), then
 // puts the current look back on the GPU.
 rs_result vw_looks_render_compared(vw_viewer *v, rs_error *err);
+
+// viewer.c: the brush from the current product, size, opacity, eraser, mirror, region toggle.
+void vw_apply_brush(vw_viewer *v);
+
+// viewer_editor.c
+void vw_editor_layout_compute(const rs_ui_toolbar_layout *toolbar, float scale, vw_editor_layout *out);
+const rs_cosmetic *vw_current_cosmetic(const vw_viewer *v);  // the custom product or the selected preset
+void vw_editor_sync(vw_viewer *v);     // show the selected preset (when no custom product is in use)
+void vw_editor_toggle(vw_viewer *v);   // C, the swatch row's Edit chip
+bool vw_editor_key(vw_viewer *v, int key, int mods);  // true when the editor took the key
+bool vw_editor_char(vw_viewer *v, unsigned codepoint);
+void vw_editor_draw(vw_viewer *v, const rs_ui_toolbar_layout *toolbar);  // into v->ui; handles its input
 
 // viewer_draw.c
 // The rendered picture (and the split's bare half) filling the window, into `ui`'s list.

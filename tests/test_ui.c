@@ -4,6 +4,7 @@
 #include "support/harness.h"
 #include "gl/gl.h"
 #include "ui.h"
+#include "viewer_internal.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -489,9 +490,64 @@ static void test_toolbar_render_at_2x_is_the_1x_layout_doubled(void)
     rs_image_free(&half);
 }
 
+// The product editor's colour maths: every preset's colour and a sweep of others survive sRGB -> HSV ->
+// sRGB exactly (the picker starts from the product's colour, so opening it must not change the colour).
+static void test_editor_hsv_round_trip(void)
+{
+    int bad = 0;
+    for (uint32_t i = 0; i < rs_cosmetic_count(); i++) {
+        const rs_cosmetic *c = rs_cosmetic_get(i);
+        float h, s, v;
+        uint8_t back[3];
+        rs_cosmetic_rgb_to_hsv(c->rgb, &h, &s, &v);
+        rs_cosmetic_hsv_to_rgb(h, s, v, back);
+        bad += memcmp(back, c->rgb, 3) != 0;
+    }
+    for (int r = 0; r < 256; r += 15)
+        for (int g = 0; g < 256; g += 17)
+            for (int b = 0; b < 256; b += 13) {
+                uint8_t rgb[3] = {(uint8_t)r, (uint8_t)g, (uint8_t)b}, back[3];
+                float h, s, v;
+                rs_cosmetic_rgb_to_hsv(rgb, &h, &s, &v);
+                RS_CHECK(h >= 0 && h < 360 && s >= 0 && s <= 1 && v >= 0 && v <= 1, "hsv range %g %g %g", h, s, v);
+                rs_cosmetic_hsv_to_rgb(h, s, v, back);
+                bad += memcmp(back, rgb, 3) != 0;
+            }
+    RS_CHECK(bad == 0, "%d colours changed through HSV", bad);
+}
+
+// The editor panel fits the window between the top bar, the right rail and the swatch sheet, its controls
+// inside it, touch-sized, at the sizes people use.
+static void test_editor_layout_fits_beside_the_toolbar(void)
+{
+    const int sizes[][2] = {{800, 600}, {1280, 720}, {1920, 1080}, {1024, 768}};
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; k++) {
+        int w = sizes[k][0], h = sizes[k][1];
+        float scale = h >= 1000 ? 1.5f : 1.0f;
+        rs_ui_toolbar_layout tb;
+        rs_ui_toolbar_layout_compute(w, h, scale, (int)rs_cosmetic_count(), &tb);
+        vw_editor_layout l;
+        vw_editor_layout_compute(&tb, scale, &l);
+        rs_ui_rect p = l.panel;
+        RS_CHECK(p.x >= 0 && p.y >= tb.top.y + tb.top.h && p.x + p.w <= tb.right.x && p.y + p.h <= tb.bottom.y,
+                 "%dx%d: panel (%.0f %.0f %.0f %.0f) overlaps the toolbar or leaves the window", w, h, p.x, p.y, p.w,
+                 p.h);
+        rs_ui_rect parts[] = {l.close, l.sv, l.hue, l.swatch, l.hex, l.finish[0], l.finish[RS_FINISH_COUNT - 1],
+                              l.coverage};
+        for (size_t i = 0; i < sizeof parts / sizeof *parts; i++) {
+            rs_ui_rect r = parts[i];
+            RS_CHECK(r.x >= p.x && r.y >= p.y && r.x + r.w <= p.x + p.w + 0.5f && r.y + r.h <= p.y + p.h + 0.5f,
+                     "%dx%d: control %zu outside the panel", w, h, i);
+            RS_CHECK(r.h >= 16 * scale - 0.01f, "%dx%d: control %zu only %.0f px tall", w, h, i, r.h);
+        }
+    }
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
+    RS_RUN(test_editor_hsv_round_trip);
+    RS_RUN(test_editor_layout_fits_beside_the_toolbar);
     RS_RUN(test_font_has_ink_for_every_printable_ascii_glyph);
     RS_RUN(test_font_glyphs_are_distinct);
     RS_RUN(test_font_descenders_only_below_baseline_for_gjpqy);

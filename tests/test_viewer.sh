@@ -30,7 +30,8 @@ viewer_bad_event_script_names_the_line viewer_bad_dropped_file_keeps_the_face
 viewer_key_0_resets_camera_and_light viewer_s_saves_at_full_quality viewer_recording_on_a_full_disk_keeps_the_old_file
 viewer_streamed_face_draws_the_first_level_before_the_rest viewer_stdin_not_a_face_exits_with_one_line
 viewer_and_rouge_render_show_the_same_look viewer_region_brush_keeps_lipstick_on_the_lips
-viewer_look_library_saves_refuses_clashes_loads_compares_deletes"
+viewer_look_library_saves_refuses_clashes_loads_compares_deletes
+viewer_product_editor_paints_and_saves_a_custom_product"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -461,6 +462,39 @@ if selected viewer_look_library_saves_refuses_clashes_loads_compares_deletes; th
         echo "FAIL - $name: the bin did not delete the look ($(ls "$lib" | tr '\n' ' '))"
     elif [ -n "$(ls -A "$lib")" ]; then echo "FAIL - $name: files left in the library: $(ls -A "$lib" | tr '\n' ' ')"
     else echo "ok - $name"; fi
+fi
+if selected viewer_product_editor_paints_and_saves_a_custom_product; then
+    # The product editor (C): lipstick turned into a custom product by keyboard (X + hex colour, N twice:
+    # matte -> gloss, period: coverage +10%), painted along the lips, saved with Ctrl+S as "Editor". The
+    # look must carry the custom product (its colour, the gloss coat, the coverage), and `rouge render
+    # --look` of that file must show what the window showed (S, full quality; the window's camera steps back
+    # to zoom 0.85 to clear its toolbars).
+    name=viewer_product_editor_paints_and_saves_a_custom_product
+    abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
+    abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
+    abs_out=$(cd "$out" && pwd)
+    rm -rf "$out/editor" && mkdir -p "$out/editor"
+    printf '%s\n' 'key i' 'key 9' 'key c' 'key x' 'type b03050' 'key enter' 'key n' 'key n' 'key .' \
+        'drag 372 421 428 421 20' 'move 400 580' 'idle' 'key s' 'idle' 'key ctrl+s' 'key backspace' 'key backspace' \
+        'key backspace' 'key backspace' 'key backspace' 'key backspace' 'type Editor' 'key enter' 'idle' 'quit' \
+        >"$out/editor.events"
+    (cd "$out/editor" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+        --looks "$abs_out/editor/looks" --events "$abs_out/editor.events" >"$abs_out/editor.log" 2>&1)
+    look="$out/editor/looks/Editor.look"
+    line=$(grep '^cosmetic' "$look" 2>/dev/null | head -1)
+    if [ ! -s "$look" ] || [ ! -f "$out/editor/rouge-0001.png" ]; then
+        echo "FAIL - $name: no look or screenshot ($(tail -c 200 "$out/editor.log"))"
+    elif ! echo "$line" | grep -q 'custom .*rgb=176,48,80 ' || ! echo "$line" | grep -q 'coat=1 ' ||
+        ! echo "$line" | grep -Eq 'coverage=0\.(7|69999)'; then
+        echo "FAIL - $name: the look does not carry the custom product: $line"
+    elif ! timeout 180 "$rouge" render "$face" --look "$look" --size 800x600 --max-splats 100000 --pipeline mobile \
+        --zoom 0.85 -o "$out/editor/render.png" >"$out/editor_render.log" 2>&1; then
+        echo "FAIL - $name: rouge render --look failed: $(tail -c 300 "$out/editor_render.log")"
+    else
+        same=$("$imgdiff" "$out/editor/rouge-0001.png" "$out/editor/render.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
+        if awk -v s="${same:-1}" 'BEGIN {exit !(s <= 0.0005)}'; then echo "ok - $name"
+        else echo "FAIL - $name: window vs rouge render --look: ${same:-error} of pixels over 8 ($out/editor)"; fi
+    fi
 fi
 if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
     # A stroke recording (--record) onto a full disk: the viewer says so and the old recording survives.

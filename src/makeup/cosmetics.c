@@ -206,6 +206,20 @@ void rs_cosmetic_hsv_to_rgb(float h_deg, float s, float v, uint8_t rgb[3])
     rgb[2] = (uint8_t)lrintf(RS_CLAMP(b + mm, 0.0f, 1.0f) * 255.0f);
 }
 
+void rs_cosmetic_rgb_to_hsv(const uint8_t rgb[3], float *h_deg, float *s, float *v)
+{
+    float r = rgb[0] / 255.0f, g = rgb[1] / 255.0f, b = rgb[2] / 255.0f;
+    float mx = fmaxf(r, fmaxf(g, b)), mn = fminf(r, fminf(g, b)), c = mx - mn, h = 0.0f;
+    if (c > 0.0f) {
+        if (mx == r) h = fmodf((g - b) / c + 6.0f, 6.0f);
+        else if (mx == g) h = (b - r) / c + 2.0f;
+        else h = (r - g) / c + 4.0f;
+    }
+    *h_deg = h * 60.0f;
+    *s = mx > 0.0f ? c / mx : 0.0f;
+    *v = mx;
+}
+
 static bool in01(float x) { return isfinite(x) && x >= 0.0f && x <= 1.0f; }
 
 rs_result rs_cosmetic_validate(const rs_cosmetic *c, rs_error *err)

@@ -100,6 +100,8 @@ bool rs_cosmetic_region_allows(rs_cosmetic_region r, const char *region);
 rs_cosmetic rs_cosmetic_custom(const uint8_t rgb[3], float material_weight, float m, float rho_s);
 // HSV (h in degrees, any value, wrapped; s, v in 0..1) to sRGB 8-bit: colour pickers work in HSV.
 void rs_cosmetic_hsv_to_rgb(float h_deg, float s, float v, uint8_t rgb[3]);
+// The inverse: h in [0, 360) (0 for greys), s and v in 0..1.
+void rs_cosmetic_rgb_to_hsv(const uint8_t rgb[3], float *h_deg, float *s, float *v);
 
 // Checks every field is finite and in range and the name is [a-z0-9_]+ (for cosmetics read from files).
 rs_result rs_cosmetic_validate(const rs_cosmetic *c, rs_error *err);
