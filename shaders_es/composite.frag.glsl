@@ -92,10 +92,11 @@ vec3 linear_to_srgb(vec3 c)
 // is a gap between splats (a sparse spot of a random sampling, a crease seen edge-on), not background.
 // The attribute targets hold weighted sums, so adding the neighbours' sums and normalising once gives
 // their weighted mean; the surface point and D are the neighbours' means.
-bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out vec3 D)
+bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out vec4 D)
 {
     t0 = t1 = t2 = vec4(0.0);
-    p = D = vec3(0.0);
+    p = vec3(0.0);
+    D = vec4(0.0);
     ivec2 hi = ivec2(u_viewport) - 1;
     // Quick reject (most background pixels): with 3 of the 4 edge neighbours uncovered, at most 5 of 8
     // can be covered.
@@ -116,7 +117,7 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
         t1 += texelFetch(u_attr1, q, 0);
         t2 += texelFetch(u_attr2, q, 0);
         p += pq;
-        D += texelFetch(u_diffuse, q, 0).rgb;
+        D += texelFetch(u_diffuse, q, 0);
         k++;
     }
     p /= max(float(k), 1.0);
@@ -128,11 +129,12 @@ void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 t0 = texelFetch(u_attr0, px, 0), t1, t2;
-    vec3 p, D;
+    vec3 p;
+    vec4 D;
     if (t0.a > u_min_weight && rs_visible_point(p)) {
         t1 = texelFetch(u_attr1, px, 0);
         t2 = texelFetch(u_attr2, px, 0);
-        D = texelFetch(u_diffuse, px, 0).rgb;
+        D = texelFetch(u_diffuse, px, 0);
     } else if (!fill_hole(px, t0, t1, t2, p, D)) {
         o_color = vec4(u_background, 1.0);
         return;
@@ -178,11 +180,27 @@ void main()
         C *= coat;
         // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).
         if (shimmer > 0.0) C += flakes(p, N, V, A / max(max(A.r, max(A.g, A.b)), 0.05), shadow, ao) * shimmer;
-        D = D * u_diffuse_scale + u_delta_weight * E;
-        if (u_mode == MODE_DIFFUSE) c = A * D;
+        // The Gaussians too narrow to draw take the pixel's own irradiance. At an occluding contour or a
+        // crease (nostril rim, lid fold) that pixel sees a sliver of surface edge-on, whose interpolated
+        // normal can turn fully away from (or into) the light: one pixel's E drops to 0 while every drawn
+        // level, averaged over splats, stays lit, and the missing green and blue leave a saturated red
+        // line. So where the surface is seen edge-on (N.V under ~0.3) the per-pixel E is held within
+        // [0.8, 1.25] of the narrowest drawn level's splat-averaged irradiance (its luminance, in D's
+        // alpha), keeping E's colour. Surfaces facing the eye keep their per-pixel E untouched: normal-map
+        // detail and the sharp green/blue shadow edges stay.
+        vec3 Ed = E;
+        float es = D.a * u_diffuse_scale;
+        float edge_on = 1.0 - smoothstep(0.15, 0.45, dot(N, V));
+        if (es > 0.0 && edge_on > 0.0) {
+            float le = dot(E, vec3(0.2126, 0.7152, 0.0722));
+            float lc = mix(le, clamp(le, 0.8 * es, 1.25 * es), edge_on);
+            Ed = le > 1e-6 ? E * (lc / le) : vec3(lc);
+        }
+        vec3 Dd = D.rgb * u_diffuse_scale + u_delta_weight * Ed;
+        if (u_mode == MODE_DIFFUSE) c = A * Dd;
         else if (u_mode == MODE_SPECULAR) c = S + C;
         else if (u_mode == MODE_IRRADIANCE) c = E;
-        else c = (u_physical == 1 ? A * D + S : A * (D + S)) + C;
+        else c = (u_physical == 1 ? A * Dd + S : A * (Dd + S)) + C;
         c *= u_exposure;
         if (u_tonemap == 0 && u_linear_output < 0.5) c = filmic(c);
     }

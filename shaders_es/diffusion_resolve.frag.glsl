@@ -18,6 +18,7 @@ uniform float u_e_max;       // the largest E can be, in the level target's unit
 uniform float u_min_weight;  // RGBA8 fallback: sums of a few 8-bit steps are unreliable
 uniform int u_res_div;       // the level target is 1/u_res_div of this target's size
 uniform float u_inv_two_sb2; // 1 / (2 sigma_b^2): sigma_b, the 3D distance scale of the upsampling
+uniform float u_smooth;      // 1 for the narrowest level: its irradiance's luminance goes to alpha
 
 out vec4 o_diffuse;
 
@@ -66,5 +67,8 @@ void main()
                 if (i != 4) a += texelFetch(u_level, clamp(px + ivec2(i % 3 - 1, i / 3 - 1), ivec2(0), hi), 0);
         }
     }
-    o_diffuse = a.a > 1e-12 ? vec4(u_weight * min(a.rgb / a.a, vec3(u_e_max)) * u_scale, 0.0) : vec4(0.0);
+    // Alpha: the narrowest level's own irradiance (luminance), the local splat-averaged light that the
+    // composite holds the per-pixel term to (composite.frag.glsl).
+    vec3 e = min(a.rgb / max(a.a, 1e-30), vec3(u_e_max));
+    o_diffuse = a.a > 1e-12 ? vec4(u_weight * e, u_smooth * dot(e, vec3(0.2126, 0.7152, 0.0722))) * u_scale : vec4(0.0);
 }

@@ -306,6 +306,7 @@ rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffus
                          0.5f * r->radius_median * rs_splat_lod_radius_scale(r->cloud, levels[i].count));
         glUniform1f(rs_uloc(resolve, "u_inv_two_sb2"), 0.5f / (sb * sb));
         glUniform3fv(rs_uloc(resolve, "u_weight"), 1, levels[i].weight);
+        glUniform1f(rs_uloc(resolve, "u_smooth"), i == 0 ? 1.0f : 0.0f);
         glUniform1f(rs_uloc(resolve, "u_scale"), d_scale / e_scale);
         glUniform1f(rs_uloc(resolve, "u_e_max"), r->float_rt ? 1e30f : 1.0f);
         // A level's weights sum to ~0.4 (100 steps) where sampled; under 16 steps, rounding dominates.
