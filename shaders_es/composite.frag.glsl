@@ -125,13 +125,44 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
     return k >= 6;
 }
 
+// Anti-aliased silhouette: a face pixel that touches the background (in its 3x3 neighbourhood) is drawn
+// with coverage (n - 1) / 8 for its n face pixels there, the background showing through the rest. That is
+// a box filter of the face's mask, one pixel wide: a straight edge's last pixel at 5/8, the outer corner of
+// a stair step at 3/8, an inner corner at 7/8, a stray pixel outside the edge gone. The mask is binary and
+// stable from frame to frame, so the edge is smooth without the speckle the splats' own (noisy) weights
+// give; pixels with no background near are untouched.
+bool uncovered(ivec2 q)
+{
+    return texelFetch(u_attr0, clamp(q, ivec2(0), ivec2(u_viewport) - 1), 0).a <= u_min_weight;
+}
+
+// Background proper: uncovered, and not a gap that fill_hole fills (at least 6 of 8 neighbours covered).
+bool background_at(ivec2 q)
+{
+    if (!uncovered(q)) return false;
+    int covered = 0;
+    for (int i = 0; i < 9; i++)
+        if (i != 4 && !uncovered(q + ivec2(i % 3 - 1, i / 3 - 1))) covered++;
+    return covered < 6;
+}
+
+float coverage(ivec2 px)
+{
+    int n = 9;
+    for (int i = 0; i < 9; i++)
+        if (i != 4 && uncovered(px + ivec2(i % 3 - 1, i / 3 - 1)) && background_at(px + ivec2(i % 3 - 1, i / 3 - 1))) n--;
+    return n == 9 ? 1.0 : float(n - 1) / 8.0;
+}
+
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
     vec4 t0 = texelFetch(u_attr0, px, 0), t1, t2;
     vec3 p;
     vec4 D;
+    float alpha = 1.0;
     if (t0.a > u_min_weight && rs_visible_point(p)) {
+        alpha = coverage(px);
         t1 = texelFetch(u_attr1, px, 0);
         t2 = texelFetch(u_attr2, px, 0);
         D = texelFetch(u_diffuse, px, 0);
@@ -204,5 +235,6 @@ void main()
         c *= u_exposure;
         if (u_tonemap == 0 && u_linear_output < 0.5) c = filmic(c);
     }
-    o_color = vec4(u_linear_output > 0.5 ? clamp(c, 0.0, 1.0) : linear_to_srgb(c), 1.0);
+    c = u_linear_output > 0.5 ? clamp(c, 0.0, 1.0) : linear_to_srgb(c);
+    o_color = vec4(mix(u_background, c, alpha), 1.0);
 }

@@ -8,6 +8,9 @@
 // `diffuse` (A * D, no specular to hide anything) keeps a milder excess where the alar groove meets the
 // cheek, from the drawn levels themselves: bounded at 10/255 (before the fix: +8 and +20 reference, +18
 // and +32 mobile, full and diffuse).
+// The silhouette is anti-aliased: rendered over magenta and over green, a pixel's coverage is how little
+// it changes with the background; most pixels on the face's outline must be partly covered (before: every
+// pixel was all face or all background), and pixels away from the outline must not depend on it.
 #include "support/harness.h"
 #include "core/image.h"
 #include "gl/gl.h"
@@ -87,6 +90,52 @@ out:
     free(albedo), free(normals), free(regions), free(full), free(diffuse), free(band);
 }
 
+static void test_silhouette_pixels_are_partly_covered(void)
+{
+    size_t n = (size_t)SIZE * SIZE * 4;
+    uint8_t *m = malloc(n), *g = malloc(n);
+    rouge_error e = {0};
+    rouge_view saved = rouge_face_get_view(face), v = {.width = SIZE, .height = SIZE, .mode = ROUGE_MODE_ALBEDO};
+    if (!RS_CHECK(m && g, "out of memory")) goto out;
+    for (int k = 0; k < 2; k++) {
+        v.background[0] = k ? 0.0f : 1.0f, v.background[1] = k ? 1.0f : 0.0f, v.background[2] = k ? 0.0f : 1.0f;
+        v.background[3] = 1.0f;
+        if (!RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "view: %s", e.msg)) goto out;
+        if (!RS_CHECK(rouge_face_render(face, &e) == ROUGE_OK, "render: %s", e.msg)) goto out;
+        if (!RS_CHECK(rouge_face_read_rgba(face, k ? g : m, n, &e) == ROUGE_OK, "read: %s", e.msg)) goto out;
+    }
+    // Coverage from green (0 on magenta, 255 on green): a = 1 - |G_m - G_g| / 255.
+    int outline = 0, partial = 0, interior_changed = 0;
+    for (int y = 1; y < SIZE - 1; y++)
+        for (int x = 1; x < SIZE - 1; x++) {
+            int i = y * SIZE + x;
+            float a = 1.0f - (float)abs(m[4 * i + 1] - g[4 * i + 1]) / 255.0f;
+            if (a <= 0.0f) continue;
+            bool edge = false, near = false;
+            for (int k = 0; k < 25; k++) {
+                int xx = x + k % 5 - 2, yy = y + k / 5 - 2;
+                if (xx < 0 || yy < 0 || xx >= SIZE || yy >= SIZE) continue;
+                int j = yy * SIZE + xx;
+                bool bg = m[4 * j + 1] == 0 && g[4 * j + 1] == 255 && m[4 * j] == 255;
+                near = near || bg;
+                edge = edge || (bg && abs(k % 5 - 2) + abs(k / 5 - 2) == 1);
+            }
+            if (edge) {
+                outline++;
+                partial += a > 0.05f && a < 0.95f;
+            }
+            if (!near) interior_changed += memcmp(m + 4 * i, g + 4 * i, 3) != 0;
+        }
+    printf("# silhouette: %d of %d outline pixels partly covered; %d pixels away from it depend on the background\n",
+           partial, outline, interior_changed);
+    RS_CHECK(outline > 100, "only %d outline pixels", outline);
+    RS_CHECK(partial >= outline * 7 / 10, "only %d of %d outline pixels partly covered", partial, outline);
+    RS_CHECK(interior_changed == 0, "%d pixels away from the outline depend on the background", interior_changed);
+out:
+    rouge_face_set_view(face, &saved, NULL);
+    free(m), free(g);
+}
+
 static void test_no_red_lines_in_creases_reference(void) { check_pipeline(ROUGE_PIPELINE_REFERENCE, "reference"); }
 static void test_no_red_lines_in_creases_mobile(void) { check_pipeline(ROUGE_PIPELINE_MOBILE, "mobile"); }
 
@@ -108,6 +157,7 @@ int main(int argc, char **argv)
         rs_gl_destroy(gl);
         return rs_test_finish();
     }
+    RS_RUN(test_silhouette_pixels_are_partly_covered);
     if (rouge_face_target(face, "nose", 0, &e) != ROUGE_OK) {
         printf("FAIL - edges_target: %s\n", e.msg);
     } else {
