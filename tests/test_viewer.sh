@@ -39,6 +39,10 @@ skip_all() {
 command -v Xvfb >/dev/null 2>&1 || skip_all "Xvfb not installed (make deps)"
 [ -f "$face" ] || skip_all "no $face (set RS_TEST_FACE or build the bundled face)"
 [ -x "$rouge" ] && [ -x "$imgdiff" ] || skip_all "$rouge or $imgdiff not built"
+# Absolute paths, for the tests that run the viewer in a folder of their own (S writes ./rouge-NNNN.png).
+abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
+abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
+abs_out=$(cd "$out" && pwd)
 "$rouge" --help 2>/dev/null | grep -q -- "--events" || skip_all "$rouge has no --events option"
 
 # A free display number: no lock file and no socket.
@@ -286,9 +290,6 @@ if selected viewer_s_saves_at_full_quality; then
     # S pressed right after an orbit (the picture still coarse) must save the same picture as S pressed once
     # it has refined: the shot waits for full quality. Each run in its own folder (S writes ./rouge-NNNN.png).
     name=viewer_s_saves_at_full_quality
-    abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
-    abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
-    abs_out=$(cd "$out" && pwd)
     for run in early late; do
         rm -rf "$out/s_$run" && mkdir -p "$out/s_$run"
         # An orbit drag in view mode (the ladder coarsens while it lasts), then S at once or after refining.
@@ -310,9 +311,6 @@ if selected viewer_and_rouge_render_show_the_same_look; then
     # replayed by `rouge render` (the public API) at the same size and splat budget must give the same
     # picture: the two paths share the pipeline, the makeup uniforms and the default lighting.
     name=viewer_and_rouge_render_show_the_same_look
-    abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
-    abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
-    abs_out=$(cd "$out" && pwd)
     rm -rf "$out/same" && mkdir -p "$out/same"
     printf 'key i\nmove 400 580\nidle\nkey s\nidle\nkey p\nkey 9\ndrag 372 421 428 421 20\nmove 400 580\nidle\nkey s\nidle\nquit\n' \
         >"$out/same.events"
@@ -470,9 +468,6 @@ if selected viewer_product_editor_paints_and_saves_a_custom_product; then
     # --look` of that file must show what the window showed (S, full quality; the window's camera steps back
     # to zoom 0.85 to clear its toolbars).
     name=viewer_product_editor_paints_and_saves_a_custom_product
-    abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/$(basename "$rouge")
-    abs_face=$(cd "$(dirname "$face")" && pwd)/$(basename "$face")
-    abs_out=$(cd "$out" && pwd)
     rm -rf "$out/editor" && mkdir -p "$out/editor"
     printf '%s\n' 'key i' 'key 9' 'key c' 'key x' 'type b03050' 'key enter' 'key n' 'key n' 'key .' \
         'drag 372 421 428 421 20' 'move 400 580' 'idle' 'key s' 'idle' 'key ctrl+s' 'key backspace' 'key backspace' \
