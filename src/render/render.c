@@ -653,9 +653,10 @@ static void clear_dirty(rs_renderer *r)
 // Stages 3 and 5 again inside the dirty rectangle, over the last frame's depth, shadow map and D.
 static rs_result incremental_frame(rs_renderer *r, rs_frame *f, rs_error *err)
 {
-    float *d = r->dirty;
-    int x0 = (int)floorf(fmaxf(d[0], 0.0f)), y0 = (int)floorf(fmaxf(d[1], 0.0f));
-    int x1 = (int)ceilf(fminf(d[2], (float)f->cam.width)), y1 = (int)ceilf(fminf(d[3], (float)f->cam.height));
+    float *d = r->dirty, w = (float)f->cam.width, h = (float)f->cam.height;
+    // Clamped to the target before the conversion: an empty rectangle is (inf, -inf), no int.
+    int x0 = (int)floorf(RS_CLAMP(d[0], 0.0f, w)), y0 = (int)floorf(RS_CLAMP(d[1], 0.0f, h));
+    int x1 = (int)ceilf(RS_CLAMP(d[2], 0.0f, w)), y1 = (int)ceilf(RS_CLAMP(d[3], 0.0f, h));
     clear_dirty(r);
     r->inc_frames++;
     if (x1 <= x0 || y1 <= y0) return RS_OK;  // nothing drawn changed

@@ -51,7 +51,10 @@ static void draw_disk(float *depth, const ao_dir *o, const float p[3], const rs_
     // Depth along d per texel of map offset, on the disk's plane (bounded: the disk spans +-r in depth).
     float gx = fabsf(nd) > 1e-3f ? -nu / nd * texel : 0.0f, gy = fabsf(nd) > 1e-3f ? -nv / nd * texel : 0.0f;
     float reach = s->radius;
-    int x0 = (int)floorf(x - rr), x1 = (int)floorf(x + rr), y0 = (int)floorf(y - rr), y1 = (int)floorf(y + rr);
+    // Clamped to the map before the conversion (a degenerate cloud can put a disk 1e20 texels away).
+    const float lo = -1.0f, hi = (float)AO_MAP;
+    int x0 = (int)floorf(RS_CLAMP(x - rr, lo, hi)), x1 = (int)floorf(RS_CLAMP(x + rr, lo, hi));
+    int y0 = (int)floorf(RS_CLAMP(y - rr, lo, hi)), y1 = (int)floorf(RS_CLAMP(y + rr, lo, hi));
     for (int yy = RS_MAX(y0, 0); yy <= RS_MIN(y1, AO_MAP - 1); yy++)
         for (int xx = RS_MAX(x0, 0); xx <= RS_MIN(x1, AO_MAP - 1); xx++) {
             float dx = (float)xx + 0.5f - x, dy = (float)yy + 0.5f - y;
