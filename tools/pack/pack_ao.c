@@ -101,8 +101,9 @@ rs_result rs_pack_ao(const rs_splat *s, uint32_t n, uint8_t *ao, rs_error *err)
             float nd = dot3(s[i].normal, o.d);
             if (nd <= 0.0f) continue;
             float p[3] = {(float)(s[i].pos[0] - c[0]), (float)(s[i].pos[1] - c[1]), (float)(s[i].pos[2] - c[2])};
-            int x = (int)floorf((dot3(p, o.u) + R) / texel), y = (int)floorf((dot3(p, o.v) + R) / texel);
-            x = RS_CLAMP(x, 0, AO_MAP - 1), y = RS_CLAMP(y, 0, AO_MAP - 1);
+            const float hi = (float)(AO_MAP - 1);
+            int x = (int)floorf(RS_CLAMP((dot3(p, o.u) + R) / texel, 0.0f, hi));
+            int y = (int)floorf(RS_CLAMP((dot3(p, o.v) + R) / texel, 0.0f, hi));
             float slope = fminf(sqrtf(fmaxf(1.0f - nd * nd, 0.0f)) / nd, 10.0f);
             float bias = s[i].radius + texel * (1.0f + slope);
             total[i] += nd;
