@@ -1,17 +1,15 @@
 // viewer.c — `rouge view`: the face in a GLFW window with a mobile-style makeup toolbar.
 //
 // One frame: poll GLFW (callbacks only queue events), let the --events script queue its events, route
-// each event to the UI or the scene (orbit / paint through src/paint/paint.c / pan / zoom / light), re-render
-// the face only when something changed (coarser LOD while the user interacts, full quality once idle),
-// draw the picture, the toolbar and overlays with app/ui.h, swap. The makeup layer, stroke filter,
-// picking and look files belong to their modules; this file maps what a person does onto them.
+// each event to the UI or the scene (orbit / paint / pan / zoom / light), re-render the face only when
+// something changed (coarser LOD while the user interacts, full quality once idle), draw the picture, the
+// toolbar and overlays with app/ui.h, swap. The face (rendering, painting, picking, looks, stroke
+// recording) is a rouge_face of the public API (rouge.h), as in any host: `rouge render` and the viewer
+// cannot disagree. This file maps what a person does onto it.
 #define _POSIX_C_SOURCE 200809L
 #include "app.h"
 #include "viewer_internal.h"
-#include "formats/look.h"
-#include "makeup/makeup.h"
-#include "paint/paint.h"
-#include "formats/strokes.h"
+#include "formats/env_lookup.h"
 #include "ui.h"
 
 #define GLFW_INCLUDE_NONE
@@ -130,39 +128,46 @@ float vw_size_to_slider(float size_rel)
 
 static float slider_to_size(float v) { return SIZE_MIN_REL * powf(SIZE_MAX_REL / SIZE_MIN_REL, v); }
 
-// --- picker callbacks (the renderer's ID buffer for the view on screen) -------------------------------
+// --- the face's view ---------------------------------------------------------------------------------------
+
+// Hands the view as the viewer holds it to the face: picks and strokes then see the camera on screen.
+static void push_view(vw_viewer *v)
+{
+    if (!v->face) return;
+    rouge_error e = {0};
+    v->view.env = v->env_name;
+    if (rouge_face_set_view(v->face, &v->view, &e) != ROUGE_OK) vw_toast(v, true, "%s", e.msg);
+}
 
 // Pointer positions are framebuffer pixels; the picture may be rendered at a lower resolution
-// (render_scale) while the user interacts.
-bool vw_pick(void *user, float x, float y, uint32_t *idx, float hit[3])
+// (render_scale) while the user interacts, and the face works in the pixels of its last frame.
+bool vw_pick(vw_viewer *v, float x, float y, rouge_pick *out)
 {
-    vw_viewer *v = user;
-    return rs_render_pick(v->ren, &v->view, x * v->render_scale, y * v->render_scale, idx, hit);
-}
-
-float vw_pixels_per_unit(void *user, const float pos[3])
-{
-    vw_viewer *v = user;
-    return rs_render_pixels_per_unit(v->ren, &v->view, pos) / v->render_scale;
-}
-
-static void view_dir_cb(void *user, const float pos[3], float dir[3])
-{
-    vw_viewer *v = user;
-    rs_render_view_dir(v->ren, &v->view, pos, dir);
+    if (!v->face || !rouge_face_pick(v->face, x * v->render_scale, y * v->render_scale, out)) return false;
+    out->brush_radius_px /= v->render_scale;
+    return true;
 }
 
 // --- brush and view state -----------------------------------------------------------------------------
 
 void vw_apply_brush(vw_viewer *v)
 {
-    if (!v->paint) return;
-    rs_paint_brush b = {.cosmetic = *vw_current_cosmetic(v), .size_rel = v->size_rel,
-                        .opacity = v->opacity, .pressure = RS_MAKEUP_PRESSURE_FLOOR, .eraser = v->eraser,
-                        .mirror = v->mirror, .any_region = v->any_region};
-    rs_paint_set_brush(v->paint, &b);
+    if (!v->face) return;
+    // The product as the public brush: the preset, and what the editor changed about it.
+    const rs_cosmetic *c = vw_current_cosmetic(v), *preset = rs_cosmetic_get((uint32_t)v->cosmetic);
+    rouge_brush b = {.cosmetic = preset->name, .size = v->size_rel, .opacity = v->opacity, .eraser = v->eraser,
+                     .mirror = v->mirror, .any_region = v->any_region};
+    if (v->editor.custom) {
+        if (memcmp(c->rgb, preset->rgb, 3) != 0)
+            for (int i = 0; i < 3; i++) b.color[i] = c->rgb[i] / 255.0f, b.color[3] = 1;
+        if (c->m != preset->m || c->rho_s != preset->rho_s || c->coat != preset->coat || c->shimmer != preset->shimmer)
+            b.finish = (rouge_finish)(rs_cosmetic_finish(c) + 1);
+        if (c->coverage != preset->coverage) b.coverage = c->coverage > 0 ? c->coverage : -1.0f;
+    }
+    rouge_error e = {0};
+    if (rouge_face_set_brush(v->face, &b, &e) != ROUGE_OK) vw_toast(v, true, "%s", e.msg);
     // A preview's makeup would be lost when the whole face replaces it: painting waits for the rest.
-    rs_paint_set_mode(v->paint, v->paint_mode && !v->partial ? RS_INPUT_PAINT : RS_INPUT_VIEW);
+    rouge_face_set_painting(v->face, v->paint_mode && !v->partial);
 }
 
 // Where the current product's brush stays ("lips"), NULL when it paints anywhere.
@@ -197,14 +202,14 @@ static void select_cosmetic(vw_viewer *v, int i)
     vw_apply_brush(v);
 }
 
-static bool env_lit(const vw_viewer *v) { return v->view.lighting == RS_LIGHTING_ENV && v->env_cpu; }
+static bool env_lit(const vw_viewer *v) { return !rs_env_is_paper(v->env_name); }
 
 // Under an environment the dial turns the world around the face (its sideways position is the
 // rotation, a half turn at the rim); under `paper` it points the key light.
 static void light_from_dial(vw_viewer *v)
 {
     if (env_lit(v)) {
-        v->view.env_rotate_deg = v->light_dial[0] * 180.0f;
+        v->view.env_rotation_deg = v->light_dial[0] * 180.0f;
     } else {
         v->view.key.yaw_deg = v->light_dial[0] * LIGHT_DIAL_DEG;
         v->view.key.pitch_deg = v->light_dial[1] * LIGHT_DIAL_DEG;
@@ -215,7 +220,7 @@ static void light_from_dial(vw_viewer *v)
 static void dial_from_light(vw_viewer *v)
 {
     if (env_lit(v)) {
-        v->light_dial[0] = RS_CLAMP(v->view.env_rotate_deg / 180.0f, -1.0f, 1.0f), v->light_dial[1] = 0;
+        v->light_dial[0] = RS_CLAMP(v->view.env_rotation_deg / 180.0f, -1.0f, 1.0f), v->light_dial[1] = 0;
         return;
     }
     float x = v->view.key.yaw_deg / LIGHT_DIAL_DEG, y = v->view.key.pitch_deg / LIGHT_DIAL_DEG;
@@ -228,24 +233,32 @@ static void dial_from_light(vw_viewer *v)
 // current one stays and a toast says why.
 bool vw_set_env(vw_viewer *v, const char *name)
 {
-    rs_error err = {0};
-    if (rs_env_is_paper(name)) {
-        v->view.lighting = RS_LIGHTING_LIGHTS;
-    } else {
-        rs_env *e = NULL;
-        if (rs_env_open(name, v->env_dir, &e, &err) != RS_OK ||
-            (v->ren && rs_render_set_env(v->ren, e, &err) != RS_OK)) {
-            rs_env_destroy(e);
-            // A failed upload leaves the renderer without one: put the previous environment back.
-            if (v->ren && v->env_cpu && !rs_render_has_env(v->ren)) rs_render_set_env(v->ren, v->env_cpu, NULL);
+    if (strlen(name) >= sizeof v->env_name) {
+        vw_toast(v, true, "environment name too long: %.60s...", name);
+        return false;
+    }
+    rouge_error err = {0};
+    if (v->face) {
+        // The face loads (and checks) it; on failure its previous environment stays.
+        rouge_view t = v->view;
+        t.env = name;
+        if (rouge_face_set_view(v->face, &t, &err) != ROUGE_OK) {
             vw_toast(v, true, "%s", err.msg);
             return false;
         }
-        rs_env_destroy(v->env_cpu);
-        v->env_cpu = e;
-        v->view.lighting = RS_LIGHTING_ENV;
+    } else if (!rs_env_is_paper(name)) {
+        // No face yet (start-up): check that it loads, so a bad --env fails at once.
+        rs_env *e = NULL;
+        rs_error e2 = {0};
+        rs_result r = rs_env_open(name, v->env_dir, &e, &e2);
+        rs_env_destroy(e);
+        if (r) {
+            vw_toast(v, true, "%s", e2.msg);
+            return false;
+        }
     }
     snprintf(v->env_name, sizeof v->env_name, "%s", name);
+    v->view.env = v->env_name;
     dial_from_light(v);
     v->dirty_view = true;
     return true;
@@ -253,11 +266,11 @@ bool vw_set_env(vw_viewer *v, const char *name)
 
 static void next_env(vw_viewer *v, int step)
 {
-    int n = rs_env_name_count(), cur = 0;
+    int n = rouge_environment_count(), cur = 0;
     for (int i = 0; i < n; i++)
-        if (strcmp(rs_env_name(i), v->env_name) == 0) cur = i;
+        if (strcmp(rouge_environment_name(i), v->env_name) == 0) cur = i;
     for (int k = 1; k < n; k++)  // skips one that fails to load
-        if (vw_set_env(v, rs_env_name(((cur + step * k) % n + n) % n))) break;
+        if (vw_set_env(v, rouge_environment_name(((cur + step * k) % n + n) % n))) break;
 }
 
 static void reset_camera(vw_viewer *v)
@@ -307,69 +320,48 @@ static void mark_input(vw_viewer *v)
     v->last_input_frame = v->frame_no;
 }
 
-static void upload(vw_viewer *v, rs_makeup_range d)
-{
-    if (d.lo >= d.hi) return;
-    rs_error err = {0};
-    const rs_makeup_gpu *rec = rs_makeup_records(v->mk);
-    if (rs_render_update_makeup(v->ren, d.lo, d.hi - d.lo, rec + d.lo, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
-    v->dirty_makeup = true;
-}
-
 // --- the face: load (in a thread, with a loading screen), open, swap -------------------------------------
 
 #define VW_READ_BYTES (256u << 10)
 #define VW_PREVIEW_EVERY_S 0.5  // a slow stream refines at most this often (each face opened costs a renderer)
 #define VW_PREVIEW_AFTER_S 0.1  // a local 600k face loads in ~40 ms: no preview for it
 
-// Reads the file (or standard input for "-") into an rs_splat_loader, publishing previews as LOD levels
-// complete. Standard input is polled so that quitting cancels a stalled stream.
+// Reads the file (or standard input for "-") into the stream; the frame loop makes preview faces from
+// it as LOD levels complete. Standard input is polled so that quitting cancels a stalled stream.
 static void *load_main(void *arg)
 {
     vw_loader *l = arg;
     bool in = !strcmp(l->path, "-");
     int fd = in ? 0 : open(l->path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    rs_splat_loader *ld = NULL;
     uint8_t *buf = NULL;
-    rs_result r = RS_OK;
+    rouge_result r = ROUGE_OK;
     struct stat st;
-    uint64_t size = 0;
-    if (fd < 0) r = rs_fail(&l->err, RS_ERR_IO, "%s: cannot open: %s", l->path, strerror(errno));
-    else if (!in && fstat(fd, &st) != 0) r = rs_fail(&l->err, RS_ERR_IO, "%s: cannot stat: %s", l->path, strerror(errno));
+    rs_error e = {0};
+    if (fd < 0) rs_fail(&e, RS_ERR_IO, "%s: cannot open: %s", l->path, strerror(errno));
+    else if (!in && fstat(fd, &st) != 0) rs_fail(&e, RS_ERR_IO, "%s: cannot stat: %s", l->path, strerror(errno));
     // Regular files only (or an explicit "-"): a directory, /dev/zero or a FIFO would hang or never end.
-    else if (!in && !S_ISREG(st.st_mode)) r = rs_fail(&l->err, RS_ERR_IO, "%s: not a regular file", l->path);
-    else size = in ? 0 : (uint64_t)st.st_size;
-    if (!r) r = rs_splat_loader_create(&(rs_splat_loader_desc){.name = in ? "(standard input)" : l->path,
-                                                               .total_bytes = size}, &ld, &l->err);
-    if (!r && !(buf = malloc(VW_READ_BYTES))) r = rs_fail(&l->err, RS_ERR_NOMEM, "%s: out of memory", l->path);
-    uint32_t shown = 0;
-    double last = 0;
-    while (!r && !atomic_load(&l->cancel) && !rs_splat_loader_complete(ld)) {
+    else if (!in && !S_ISREG(st.st_mode)) rs_fail(&e, RS_ERR_IO, "%s: not a regular file", l->path);
+    else if (!(buf = malloc(VW_READ_BYTES))) rs_fail(&e, RS_ERR_NOMEM, "%s: out of memory", l->path);
+    if (e.code) r = (rouge_result)e.code, l->err.code = r, memcpy(l->err.msg, e.msg, sizeof l->err.msg);
+    while (!r && !atomic_load(&l->cancel) && !rouge_stream_get_progress(l->stream).complete) {
         if (in) {
             struct pollfd pfd = {.fd = fd, .events = POLLIN};
             if (poll(&pfd, 1, 100) == 0) continue;
         }
         ssize_t n = read(fd, buf, VW_READ_BYTES);
         if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
-        if (n < 0) r = rs_fail(&l->err, RS_ERR_IO, "%s: read failed: %s", l->path, strerror(errno));
-        if (n <= 0) break;
-        r = rs_splat_loader_feed(ld, buf, (size_t)n, &l->err);
-        const rs_splat_header *h = rs_splat_loader_header(ld);
-        uint32_t ready = rs_splat_loader_ready(ld);
-        rs_splat_cloud *p = NULL;
-        if (!r && h && ready > shown && ready < h->count && (!shown || rs_time_now() - last >= VW_PREVIEW_EVERY_S)) {
-            rs_error e = {0};
-            if (rs_splat_loader_preview(ld, ready, &p, &e) == RS_OK) shown = ready, last = rs_time_now();
+        if (n < 0) {
+            l->err.code = r = ROUGE_ERR_IO;
+            snprintf(l->err.msg, sizeof l->err.msg, "%s: read failed: %s", l->path, strerror(errno));
         }
-        pthread_mutex_lock(&l->mu);
-        l->decoded = rs_splat_loader_decoded(ld);
-        l->count = h ? h->count : 0;
-        if (p) rs_splat_destroy(l->preview), l->preview = p;
-        pthread_mutex_unlock(&l->mu);
+        if (n <= 0) break;
+        r = rouge_stream_feed(l->stream, buf, (size_t)n, &l->err);
     }
-    if (!r && atomic_load(&l->cancel)) r = rs_fail(&l->err, RS_ERR_IO, "%s: loading cancelled", l->path);
-    if (!r) r = rs_splat_loader_finish(ld, &l->cloud, &l->err);
-    rs_splat_loader_destroy(ld);
+    if (!r && !rouge_stream_get_progress(l->stream).complete) {
+        l->err.code = r = ROUGE_ERR_IO;
+        snprintf(l->err.msg, sizeof l->err.msg, "%s: %s", l->path,
+                 atomic_load(&l->cancel) ? "loading cancelled" : "the file ends early (truncated)");
+    }
     free(buf);
     if (fd > 0) close(fd);
     l->result = r;
@@ -386,48 +378,52 @@ static rs_result load_start(vw_viewer *v, const char *path, rs_error *err)
     l->t0 = glfwGetTime();
     atomic_store(&l->done, false);
     atomic_store(&l->cancel, false);
-    pthread_mutex_init(&l->mu, NULL);
+    bool in = !strcmp(path, "-");
+    struct stat st;
+    uint64_t size = !in && stat(path, &st) == 0 && S_ISREG(st.st_mode) ? (uint64_t)st.st_size : 0;
+    rouge_error e = {0};
+    if (rouge_stream_create(in ? "(standard input)" : path, size, &l->stream, &e) != ROUGE_OK)
+        return rs_fail(err, (rs_result)e.code, "%s", e.msg);
     if (pthread_create(&l->thread, NULL, load_main, l) != 0) {
-        pthread_mutex_destroy(&l->mu);
+        rouge_stream_destroy(l->stream);
+        l->stream = NULL;
         return rs_fail(err, RS_ERR_NOMEM, "cannot start a loader thread");
     }
     l->running = true;
     return RS_OK;
 }
 
-// Joins a finished loader; false while it still runs.
+// Joins a finished loader; false while it still runs. The stream stays for the face to take.
 static bool load_finished(vw_viewer *v)
 {
     vw_loader *l = &v->load;
     if (!l->running || !atomic_load(&l->done)) return false;
     pthread_join(l->thread, NULL);
-    pthread_mutex_destroy(&l->mu);
-    rs_splat_destroy(l->preview);
-    l->preview = NULL;
     l->running = false;
     return true;
 }
 
-// Stops a load that is still running (the window closes) and drops what it made.
+// Stops a load that is still running (the window closes) and drops what it read.
 static void load_abort(vw_viewer *v)
 {
     vw_loader *l = &v->load;
-    if (!l->running) return;
-    atomic_store(&l->cancel, true);
-    while (!load_finished(v)) nanosleep(&(struct timespec){0, 10 * 1000 * 1000}, NULL);
-    rs_splat_destroy(l->cloud);
-    l->cloud = NULL;
+    if (l->running) {
+        atomic_store(&l->cancel, true);
+        while (!load_finished(v)) nanosleep(&(struct timespec){0, 10 * 1000 * 1000}, NULL);
+    }
+    rouge_stream_destroy(l->stream);
+    l->stream = NULL;
 }
 
 // The interactive quality ladder: coarser LOD prefixes first (while the face keeps a dense enough look),
 // then lower render resolutions (per-pixel passes dominate on software rasterisers), then both.
 static void build_rungs(vw_viewer *v)
 {
-    const rs_splat_header *h = &v->cloud->hdr;
+    const rouge_stats *h = &v->info;
     uint32_t nl = RS_MAX(h->lod_count, 1u);
-    uint32_t lods[RS_SPLAT_MAX_LODS];
-    for (uint32_t i = 0; i < nl; i++) lods[i] = h->lod_count ? h->lods[i] : h->count;
-    uint32_t floor_n = RS_MIN(h->count, RS_MAX(DENSE_SPLATS, 1u));
+    uint32_t lods[ROUGE_MAX_LODS];
+    for (uint32_t i = 0; i < nl; i++) lods[i] = h->lod_count ? h->lods[i] : h->splats;
+    uint32_t floor_n = RS_MIN(h->splats, RS_MAX(DENSE_SPLATS, 1u));
     uint32_t fi = 0;
     while (fi + 1 < nl && lods[fi + 1] >= floor_n) fi++;
     int n = 0;
@@ -439,45 +435,37 @@ static void build_rungs(vw_viewer *v)
     v->rung_count = n;
     // First guess: about a quarter of the splats at full resolution; the controller adapts from there.
     v->rung = 0;
-    while (v->rung + 1 <= (int)fi && v->rungs[v->rung].max_splats > h->count / 4) v->rung++;
+    while (v->rung + 1 <= (int)fi && v->rungs[v->rung].max_splats > h->splats / 4) v->rung++;
 }
 
 static void face_close(vw_viewer *v)
 {
-    rs_paint_destroy(v->paint);
-    rs_makeup_destroy(v->mk);
-    rs_render_destroy(v->ren);
-    rs_splat_destroy(v->cloud);
-    v->paint = NULL, v->mk = NULL, v->ren = NULL, v->cloud = NULL;
+    rouge_face_destroy(v->face);
+    v->face = NULL;
 }
 
-// Makes `cloud` the face on screen (takes ownership). On failure the previous face stays.
-static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path, rs_error *err)
+// Makes a face from the loader's stream the face on screen: a preview of the LOD levels so far, or the
+// whole face. On failure the previous face stays.
+static rs_result face_open(vw_viewer *v, rs_error *err)
 {
-    rs_renderer *ren = NULL;
-    rs_makeup *mk = NULL;
-    rs_paint *pt = NULL;
-    rs_result r = rs_render_create(&(rs_render_desc){.cloud = cloud, .caps = rs_window_caps(v->window)}, &ren, err);
-    if (!r && v->env_cpu) r = rs_render_set_env(ren, v->env_cpu, err);
-    if (!r) r = rs_makeup_create(cloud, NULL, &mk, err);
-    if (!r) r = rs_paint_create(mk, &v->picker, &(rs_paint_desc){.input.mode = RS_INPUT_VIEW}, &pt, err);
+    rouge_face *f = NULL;
+    rouge_error e = {0};
+    v->view.env = v->env_name;
+    rouge_result r = rouge_face_create(&(rouge_face_desc){.stream = v->load.stream, .view = &v->view,
+                                                          .env_dir = v->env_dir[0] ? v->env_dir : NULL,
+                                                          .manual_navigation = true},
+                                       &f, &e);
+    if (!r && v->cli->record) r = rouge_face_record_strokes(f, v->cli->record, &e);
     if (r) {
-        rs_paint_destroy(pt);
-        rs_makeup_destroy(mk);
-        rs_render_destroy(ren);
-        rs_splat_destroy(cloud);
-        return r;
+        rouge_face_destroy(f);
+        return rs_fail(err, (rs_result)r, "%s", e.msg);
     }
-    vw_looks_forget_face(v);
     face_close(v);
-    v->cloud = cloud, v->ren = ren, v->mk = mk, v->paint = pt;
-    // The pigment is clamped into this face's colour range, as `rouge render` does (rouge.c).
-    rs_makeup_uniforms mu;
-    rs_makeup_get_uniforms(mk, &mu);
-    rs_render_set_makeup_uniforms(ren, &mu);
-    snprintf(v->face_path, sizeof v->face_path, "%s", path);
+    vw_looks_forget_face(v);
+    v->face = f;
+    v->info = rouge_face_stats(f);
+    snprintf(v->face_path, sizeof v->face_path, "%s", v->load.path);
     vw_apply_brush(v);
-    if (v->rec) rs_paint_set_recorder(v->paint, v->rec, NULL);
     build_rungs(v);
     v->rendered_full = false;
     v->dirty_view = v->dirty_makeup = true;
@@ -486,13 +474,14 @@ static rs_result face_open(vw_viewer *v, rs_splat_cloud *cloud, const char *path
 
 rs_result vw_load_look_file(vw_viewer *v, const char *path, rs_error *err)
 {
-    rs_makeup_range d = {0, 0};
-    rs_result r = rs_look_load(v->mk, path, &d, err);
-    if (r != RS_OK) {
+    rouge_error e = {0};
+    rouge_result r = rouge_face_load_look(v->face, path, &e);
+    if (r != ROUGE_OK) {
+        rs_fail(err, (rs_result)r, "%s", e.msg);
         vw_toast(v, true, "%s", err->msg);
-        return r;
+        return (rs_result)r;
     }
-    upload(v, d);
+    v->dirty_makeup = true;
     return RS_OK;
 }
 
@@ -500,19 +489,17 @@ rs_result vw_load_look_file(vw_viewer *v, const char *path, rs_error *err)
 
 static void do_undo(vw_viewer *v, bool redo)
 {
-    rs_makeup_range d = {0, 0};
-    if (redo ? rs_makeup_redo(v->mk, &d) : rs_makeup_undo(v->mk, &d)) upload(v, d);
+    if (redo ? rouge_face_redo(v->face) : rouge_face_undo(v->face)) v->dirty_makeup = true;
 }
 
 static void do_clear(vw_viewer *v)
 {
-    rs_makeup_range d = {0, 0};
-    rs_error err = {0};
-    if (rs_makeup_clear(v->mk, &d, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
-    upload(v, d);
+    rouge_error e = {0};
+    if (rouge_face_clear(v->face, &e) != ROUGE_OK) vw_toast(v, true, "%s", e.msg);
+    v->dirty_makeup = true;
 }
 
-static void set_mode(vw_viewer *v, rs_render_mode m)
+static void set_mode(vw_viewer *v, rouge_mode m)
 {
     v->view.mode = m;
     v->dirty_view = true;
@@ -549,7 +536,7 @@ static void key_action(vw_viewer *v, int key, int mods)
     if (vw_looks_key(v, key, mods)) return;  // the look library's sheet or dialog has the keyboard
     if (vw_editor_key(v, key, mods)) return;  // the product editor's keys (X, N, comma, period, Esc)
     bool ctrl = mods & GLFW_MOD_CONTROL, shift = mods & GLFW_MOD_SHIFT;
-    int n = (int)rs_cosmetic_count();
+    int n = rouge_cosmetic_count();
     switch (key) {
     case GLFW_KEY_C: vw_editor_toggle(v); break;
     case GLFW_KEY_P: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
@@ -559,11 +546,11 @@ static void key_action(vw_viewer *v, int key, int mods)
     case GLFW_KEY_Z: if (ctrl) do_undo(v, shift); break;
     case GLFW_KEY_Y: if (ctrl) do_undo(v, true); break;
     case GLFW_KEY_DELETE: do_clear(v); break;
-    case GLFW_KEY_A: set_mode(v, RS_MODE_ALBEDO); break;
-    case GLFW_KEY_D: set_mode(v, RS_MODE_DIFFUSE); break;
-    case GLFW_KEY_F: set_mode(v, RS_MODE_FULL); break;
+    case GLFW_KEY_A: set_mode(v, ROUGE_MODE_ALBEDO); break;
+    case GLFW_KEY_D: set_mode(v, ROUGE_MODE_DIFFUSE); break;
+    case GLFW_KEY_F: set_mode(v, ROUGE_MODE_FULL); break;
     case GLFW_KEY_R:
-        v->view.pipeline = v->view.pipeline == RS_PIPELINE_MOBILE ? RS_PIPELINE_REFERENCE : RS_PIPELINE_MOBILE;
+        v->view.pipeline = v->view.pipeline == ROUGE_PIPELINE_REFERENCE ? ROUGE_PIPELINE_MOBILE : ROUGE_PIPELINE_REFERENCE;
         v->dirty_view = true;
         break;
     case GLFW_KEY_B: v->split = !v->split, v->dirty_view = true; break;
@@ -604,8 +591,9 @@ static void key_action(vw_viewer *v, int key, int mods)
     case GLFW_KEY_HOME:
         // The whole view as the viewer started: camera and the light (the dial follows).
         reset_camera(v);
-        v->view.key = v->cli->view.key;
-        v->view.env_rotate_deg = v->cli->view.env_rotate_deg;
+        rouge_view start = rs_app_public_view(&v->cli->view, v->env_name);
+        v->view.key = start.key;
+        v->view.env_rotation_deg = start.env_rotation_deg;
         dial_from_light(v);
         break;
     case GLFW_KEY_G: next_env(v, shift ? -1 : 1); break;
@@ -617,29 +605,25 @@ static void key_action(vw_viewer *v, int key, int mods)
 
 // --- input routing -------------------------------------------------------------------------------------
 
-static void feed_paint(vw_viewer *v, rs_input_type type, int id, float x, float y, double t)
+static void feed_paint(vw_viewer *v, rouge_pointer_type type, int id, float x, float y, double t)
 {
-    if (!v->paint) return;
-    if (type == RS_INPUT_DOWN && v->rec && v->paint_mode) {
-        // The stroke file records the camera the pixels refer to.
-        rs_strokes_view sv = {v->view.yaw_deg, v->view.pitch_deg, v->view.zoom, v->view.fov_deg,
-                              (uint32_t)v->fb_w, (uint32_t)v->fb_h, {v->view.pan[0], v->view.pan[1]}};
-        rs_paint_set_recorder(v->paint, v->rec, &sv);
-    }
-    rs_input_event ev = {type, id, x, y, 1.0f, t};
-    rs_paint_result res;
-    rs_error err = {0};
-    if (rs_paint_feed(v->paint, &ev, &res, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
-    if (res.orbit_dx_px != 0 || res.orbit_dy_px != 0) orbit(v, res.orbit_dx_px, res.orbit_dy_px);
-    if (res.pan_dx_px != 0 || res.pan_dy_px != 0) pan(v, res.pan_dx_px, res.pan_dy_px);
-    if (res.zoom != 1.0f && res.zoom > 0) zoom_at(v, res.zoom, res.zoom_cx_px, res.zoom_cy_px);
-    upload(v, res.dirty);
-    // The recording is rewritten (and fsynced) once the picture settles, not inside the stroke's frame.
-    if (res.stroke_end && v->rec) v->rec_unsaved = true;
-    // Navigation coarsens the picture while it moves; painting does not: the view stays, so the renderer
+    if (!v->face) return;
+    // The face picks through the camera on screen, in the pixels of its last frame.
+    if (type == ROUGE_POINTER_DOWN) push_view(v);
+    float k = v->render_scale;
+    rouge_pointer_event ev = {type, id, x * k, y * k, 1.0f, t};
+    rouge_pointer_result res;
+    rouge_error e = {0};
+    if (rouge_face_pointer(v->face, &ev, &res, &e) != ROUGE_OK) vw_toast(v, true, "%s", e.msg);
+    // Gestures come back in the frame's pixels; the viewer navigates in framebuffer pixels.
+    if (res.orbit_dx != 0 || res.orbit_dy != 0) orbit(v, res.orbit_dx / k, res.orbit_dy / k);
+    if (res.pan_dx != 0 || res.pan_dy != 0) pan(v, res.pan_dx / k, res.pan_dy / k);
+    bool zoomed = res.zoom != 1.0f && res.zoom > 0;
+    if (zoomed) zoom_at(v, res.zoom, res.zoom_x / k, res.zoom_y / k);
+    if (res.stamps || res.stroke_end || res.stroke_cancel) v->dirty_makeup = true;
+    // Navigation coarsens the picture while it moves; painting does not: the view stays, so the face
     // redraws only what the stamps touched (incremental frames) at full quality.
-    bool navigated = res.orbit_dx_px != 0 || res.orbit_dy_px != 0 || res.pan_dx_px != 0 || res.pan_dy_px != 0 ||
-                     (res.zoom != 1.0f && res.zoom > 0);
+    bool navigated = res.orbit_dx != 0 || res.orbit_dy != 0 || res.pan_dx != 0 || res.pan_dy != 0 || zoomed;
     if (navigated || !v->paint_mode) mark_input(v);
 }
 
@@ -654,7 +638,7 @@ static void pointer_button(vw_viewer *v, int b, bool down, double t)
         v->scene_owns[b] = true;
         if (b == 0) {
             v->light_drag = glfwGetKey(v->win, GLFW_KEY_L) == GLFW_PRESS;
-            if (!v->light_drag) feed_paint(v, RS_INPUT_DOWN, 0, v->mx, v->my, t);
+            if (!v->light_drag) feed_paint(v, ROUGE_POINTER_DOWN, 0, v->mx, v->my, t);
         }
         return;
     }
@@ -665,7 +649,7 @@ static void pointer_button(vw_viewer *v, int b, bool down, double t)
     }
     if (!v->scene_owns[b]) return;
     v->scene_owns[b] = false;
-    if (b == 0 && !v->light_drag) feed_paint(v, RS_INPUT_UP, 0, v->mx, v->my, t);
+    if (b == 0 && !v->light_drag) feed_paint(v, ROUGE_POINTER_UP, 0, v->mx, v->my, t);
     v->light_drag = false;
 }
 
@@ -683,7 +667,7 @@ static void pointer_move(vw_viewer *v, float x, float y, double t)
             v->dirty_view = true;
             mark_input(v);
         } else {
-            feed_paint(v, RS_INPUT_MOVE, 0, x, y, t);
+            feed_paint(v, ROUGE_POINTER_MOVE, 0, x, y, t);
         }
     }
     if (v->scene_owns[1] || v->scene_owns[2]) {
@@ -831,7 +815,7 @@ static void apply_rung(vw_viewer *v, vw_rung q)
     v->view.max_splats = q.max_splats;
 }
 
-// Renders the picture if stale; both halves in split view (the bare half only when the view changed).
+// Renders the picture if stale; both halves in split view (the left one only when the view changed).
 static rs_result render_scene(vw_viewer *v, rs_error *err)
 {
     bool inter = interacting(v);
@@ -840,27 +824,28 @@ static rs_result render_scene(vw_viewer *v, rs_error *err)
                           (!inter && !v->rendered_full);
     if (!v->dirty_view && !v->dirty_makeup && !quality_change) return RS_OK;
     apply_rung(v, want);
-    rs_result r = RS_OK;
+    rouge_error e = {0};
+    rouge_result r = ROUGE_OK;
     if (v->split && (v->dirty_view || quality_change || !v->before.tex || v->looks.compare_dirty)) {
         // The left half: the bare face, or a look from the library to compare with.
-        if (vw_looks_comparing(v)) {
-            r = vw_looks_render_compared(v, err);
-        } else {
-            v->view.hide_makeup = true;
-            r = rs_render_frame(v->ren, &v->view, err);
-            v->view.hide_makeup = false;
-        }
+        v->view.compare_look = true;
+        push_view(v);
+        r = rouge_face_render(v->face, &e);
+        v->view.compare_look = false;
         v->looks.compare_dirty = false;
         int tw, th;
-        GLuint tex = rs_render_output_texture(v->ren, &tw, &th);
-        if (!r) r = rs_ui_texture_copy(&v->before, tex, tw, th, err);
+        GLuint tex = rouge_face_texture(v->face, &tw, &th);
+        rs_error e2 = {0};
+        if (!r && rs_ui_texture_copy(&v->before, tex, tw, th, &e2)) r = (rouge_result)e2.code, e = (rouge_error){0}, memcpy(e.msg, e2.msg, sizeof e.msg);
     }
-    if (!r) r = rs_render_frame(v->ren, &v->view, err);
+    push_view(v);
+    if (!r) r = rouge_face_render(v->face, &e);
+    v->info = rouge_face_stats(v->face);
     v->dirty_view = v->dirty_makeup = false;
     v->rendered = want;
     v->rendered_full = !inter;
     v->rendered_this_frame = true;
-    return r;
+    return r ? rs_fail(err, (rs_result)r, "%s", e.msg) : RS_OK;
 }
 
 // What a toolbar tap or drag does (the same actions as the keys).
@@ -874,9 +859,9 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
     case RS_UI_TOOL_UNDO: do_undo(v, false); break;
     case RS_UI_TOOL_REDO: do_undo(v, true); break;
     case RS_UI_TOOL_CLEAR: do_clear(v); break;
-    case RS_UI_TOOL_ALBEDO: set_mode(v, RS_MODE_ALBEDO); break;
-    case RS_UI_TOOL_DIFFUSE: set_mode(v, RS_MODE_DIFFUSE); break;
-    case RS_UI_TOOL_FULL: set_mode(v, RS_MODE_FULL); break;
+    case RS_UI_TOOL_ALBEDO: set_mode(v, ROUGE_MODE_ALBEDO); break;
+    case RS_UI_TOOL_DIFFUSE: set_mode(v, ROUGE_MODE_DIFFUSE); break;
+    case RS_UI_TOOL_FULL: set_mode(v, ROUGE_MODE_FULL); break;
     case RS_UI_TOOL_PIPELINE: key_action(v, GLFW_KEY_R, 0); break;
     case RS_UI_TOOL_SPLIT: v->split = !v->split, v->dirty_view = true; break;
     case RS_UI_TOOL_HUD: v->hud = !v->hud; break;
@@ -904,7 +889,7 @@ static double frame(vw_viewer *v, const char *script_shot, const float *script_r
     v->rendered_this_frame = false;
     update_window_size(v);
     dispatch(v);
-    if (v->ren) {
+    if (v->face) {
         rs_result r = render_scene(v, err);
         if (r) {
             vw_toast(v, true, "%s", err->msg);
@@ -945,32 +930,36 @@ static double frame(vw_viewer *v, const char *script_shot, const float *script_r
 static rs_result poll_loader(vw_viewer *v, rs_error *err)
 {
     vw_loader *l = &v->load;
-    if (!l->running) return RS_OK;
-    if (!atomic_load(&l->done) && glfwGetTime() - l->t0 >= VW_PREVIEW_AFTER_S) {
-        pthread_mutex_lock(&l->mu);
-        rs_splat_cloud *p = l->preview;
-        l->preview = NULL;
-        pthread_mutex_unlock(&l->mu);
+    if (!l->stream) return RS_OK;
+    double now = glfwGetTime();
+    if (l->running && !atomic_load(&l->done) && now - l->t0 >= VW_PREVIEW_AFTER_S &&
+        (!l->shown || now - l->last_preview >= VW_PREVIEW_EVERY_S)) {
+        rouge_stream_progress p = rouge_stream_get_progress(l->stream);
         rs_error e = {0};
-        if (p && face_open(v, p, l->path, &e) == RS_OK) {
+        if (p.ready > l->shown && !p.complete && face_open(v, &e) == RS_OK) {
             if (!v->partial) reset_camera(v);
-            v->partial = true;
+            // The last bytes may have arrived meanwhile: then this face is the whole one.
+            l->shown = v->info.splats, l->last_preview = now;
+            v->partial = l->shown < p.splats;
             vw_apply_brush(v);
         }
     }
     if (!load_finished(v)) return RS_OK;
     bool was_partial = v->partial;
-    rs_result r = l->result;
-    if (!r) r = face_open(v, l->cloud, l->path, &l->err);
-    l->cloud = NULL;
+    rs_error e = {0};
+    rs_result r = (rs_result)l->result;
+    if (r) rs_fail(&e, r, "%s", l->err.msg);
+    else if (!l->shown || was_partial) r = face_open(v, &e);
+    rouge_stream_destroy(l->stream);
+    l->stream = NULL;
     v->partial = false;  // on failure a preview stays: all there is of that file
-    if (v->paint) vw_apply_brush(v);
+    if (v->face) vw_apply_brush(v);
     if (r) {
-        if (l->initial) return rs_fail(err, r, "%s", l->err.msg);
-        vw_toast(v, true, "%s", l->err.msg);
+        if (l->initial) return rs_fail(err, r, "%s", e.msg);
+        vw_toast(v, true, "%s", e.msg);
         return RS_OK;
     }
-    if (!was_partial) reset_camera(v);
+    if (!l->shown) reset_camera(v);  // a preview of this file set the camera already
     if (l->initial && v->cli->look) {
         if ((r = vw_load_look_file(v, v->cli->look, err))) return r;
         vw_toast(v, false, "Loaded look %s", v->cli->look);
@@ -983,7 +972,7 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
 static bool at_full_quality(const vw_viewer *v)
 {
     // A preview at full quality is all there is to show until more of the file arrives.
-    return v->ren && (!v->load.running || v->partial) && !interacting(v) && v->rendered_full && !v->dirty_view &&
+    return v->face && (!v->load.running || v->partial) && !interacting(v) && v->rendered_full && !v->dirty_view &&
            !v->dirty_makeup && v->queue.count == 0;
 }
 
@@ -1012,15 +1001,15 @@ static rs_result bench_orbit(vw_viewer *v, int n, rs_error *err)
         orbit(v, 6.0f * v->px_per_pt, 0);
         mark_input(v);
         double t = frame(v, NULL, NULL, err);
-        if (i >= 10) ms[i - 10] = t, splats[i - 10] = rs_render_get_stats(v->ren).splats_drawn;
+        if (i >= 10) ms[i - 10] = t, splats[i - 10] = rouge_face_stats(v->face).splats_drawn;
     }
     qsort(ms, (size_t)n, sizeof *ms, cmp_double);
     uint32_t lo = splats[0], hi = splats[0];
     for (int i = 0; i < n; i++) lo = RS_MIN(lo, splats[i]), hi = RS_MAX(hi, splats[i]);
     printf("bench-orbit: %dx%d window (%dx%d px), %s pipeline, %d frames: median %.1f ms (p90 %.1f ms), "
            "LOD %u..%u of %u splats (budget %.0f ms), %s\n",
-           v->win_w, v->win_h, v->fb_w, v->fb_h, v->view.pipeline == RS_PIPELINE_MOBILE ? "mobile" : "reference", n,
-           ms[n / 2], ms[(n * 9) / 10], lo, hi, v->cloud->hdr.count, BUDGET_MS, rs_window_caps(v->window)->renderer);
+           v->win_w, v->win_h, v->fb_w, v->fb_h, v->view.pipeline == ROUGE_PIPELINE_REFERENCE ? "reference" : "mobile",
+           n, ms[n / 2], ms[(n * 9) / 10], lo, hi, v->info.splats, BUDGET_MS, rs_window_caps(v->window)->renderer);
     free(ms);
     free(splats);
     return RS_OK;
@@ -1030,7 +1019,7 @@ static rs_result run(vw_viewer *v, rs_error *err)
 {
     const rs_cli *c = v->cli;
     char def[600];
-    rs_app_env_dir(v->env_dir, sizeof v->env_dir);
+    if (!rs_app_env_dir(v->env_dir, sizeof v->env_dir)) v->env_dir[0] = 0;
     if (!vw_set_env(v, c->env ? c->env : RS_ENV_DEFAULT))
         return rs_fail(err, RS_ERR_ARG, "%s", v->toast);
     rs_result r = load_start(v, c->face ? c->face : rs_app_default_face(def, sizeof def), err);
@@ -1038,7 +1027,7 @@ static rs_result run(vw_viewer *v, rs_error *err)
     v->load.initial = true;
     vw_options o = viewer_options(c);
     // Loading screen until the face (or a preview of it) is there; the bench waits for all of it.
-    while (!v->ren || (o.bench_orbit > 0 && v->load.running)) {
+    while (!v->face || (o.bench_orbit > 0 && v->load.running)) {
         if (glfwWindowShouldClose(v->win)) {
             load_abort(v);
             return RS_OK;
@@ -1046,7 +1035,7 @@ static rs_result run(vw_viewer *v, rs_error *err)
         glfwPollEvents();
         v->queue.count = 0;  // input during loading is dropped (nothing to act on)
         if ((r = poll_loader(v, err))) return r;
-        if (!v->ren || v->load.running) {
+        if (!v->face || v->load.running) {
             frame(v, NULL, NULL, err);
             glfwWaitEventsTimeout(0.03);
         }
@@ -1069,11 +1058,6 @@ static rs_result run(vw_viewer *v, rs_error *err)
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
         }
         frame(v, step.screenshot, step.rect, err);
-        if (v->rec_unsaved && at_full_quality(v)) {
-            rs_error e2 = {0};
-            v->rec_unsaved = false;
-            if (rs_strokes_save(v->rec, v->cli->record, &e2) != RS_OK) vw_toast(v, true, "%s", e2.msg);
-        }
     }
     return RS_OK;
 }
@@ -1089,7 +1073,6 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         r = vw_script_load(o.events, &v->script, err);
         v->have_script = r == RS_OK;
     }
-    if (!r && cli->record) r = rs_strokes_create(&v->rec, err);
     int w = o.size_set ? cli->view.width : 1024, h = o.size_set ? cli->view.height : 768;
     if (!r)
         r = rs_window_create(&(rs_window_desc){.width = w, .height = h, .title = "rouge",
@@ -1109,9 +1092,8 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         glfwSetCharCallback(v->win, on_char);
         glfwSetWindowRefreshCallback(v->win, on_refresh);
         glfwSetCursorEnterCallback(v->win, on_enter);
-        v->picker = (rs_paint_picker){.user = v, .pick = vw_pick, .pixels_per_unit = vw_pixels_per_unit, .view_dir = view_dir_cb};
-        v->view = cli->view;
-        if (!o.pipeline_set) v->view.pipeline = RS_PIPELINE_MOBILE;
+        v->view = rs_app_public_view(&cli->view, NULL);
+        if (!o.pipeline_set) v->view.pipeline = ROUGE_PIPELINE_MOBILE;
         v->split_frac = 0.5f;
         v->render_scale = 1;
         v->hud = true;
@@ -1127,20 +1109,18 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         v->mx = (float)mx * v->px_per_pt, v->my = (float)my * v->px_per_pt;
         r = run(v, err);
     }
-    if (v->rec && cli->record && v->rec->count) {
-        rs_error e2 = {0};
-        rs_result r2 = rs_strokes_save(v->rec, cli->record, &e2);
-        if (!r && r2) r = r2, *err = e2;
+    if (v->face && cli->record) {
+        // Every stroke in the recording's file before the viewer says it is done.
+        rouge_error e2 = {0};
+        if (rouge_face_flush_strokes(v->face, &e2) != ROUGE_OK && !r) r = rs_fail(err, (rs_result)e2.code, "%s", e2.msg);
     }
     load_abort(v);
     vw_looks_free(v);
     face_close(v);
-    rs_env_destroy(v->env_cpu);
     rs_ui_texture_free(&v->before);
     rs_ui_destroy(v->ui);
     rs_ui_destroy(v->scene_ui);
     rs_window_destroy(v->window);
-    rs_strokes_destroy(v->rec);
     vw_script_free(&v->script);
     free(v);
     return r;

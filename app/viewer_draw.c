@@ -22,7 +22,7 @@ static void display_name(const char *name, char *out, size_t n)
 void vw_draw_picture(vw_viewer *v, rs_ui *ui)
 {
     int tw = 0, th = 0;
-    GLuint tex = v->ren ? rs_render_output_texture(v->ren, &tw, &th) : 0;
+    GLuint tex = v->face ? rouge_face_texture(v->face, &tw, &th) : 0;
     rs_ui_rect full = {0, 0, (float)v->fb_w, (float)v->fb_h};
     // Background in the renderer's colour while nothing is rendered yet (loading).
     const float *bg = v->view.background;
@@ -72,16 +72,15 @@ static void draw_split_divider(vw_viewer *v, const rs_ui_toolbar_layout *l)
 // The brush ring: the brush's footprint on the face under the cursor (its size at that depth).
 static void draw_brush_ring(vw_viewer *v)
 {
-    if (!v->paint_mode || !v->ren || v->pointer_outside || v->scene_owns[1] || v->scene_owns[2] ||
+    if (!v->paint_mode || !v->face || v->pointer_outside || v->scene_owns[1] || v->scene_owns[2] ||
         rs_ui_captures(v->ui, v->mx, v->my))
         return;
     if (v->ring_moved && !v->scene_owns[0]) {
         // One pick per frame at most, and only when the cursor moved.
-        uint32_t idx;
-        float hit[3];
+        rouge_pick pk;
         v->ring_valid = false;
-        if (vw_pick(v, v->mx, v->my, &idx, hit)) {
-            float r = rs_paint_radius(v->paint) * vw_pixels_per_unit(v, hit);
+        if (vw_pick(v, v->mx, v->my, &pk)) {
+            float r = pk.brush_radius_px;
             if (isfinite(r) && r > 0) v->ring_px = r, v->ring_valid = true;
         }
         v->ring_moved = false;
@@ -95,20 +94,21 @@ static void draw_brush_ring(vw_viewer *v)
 
 static void draw_hud(vw_viewer *v, const rs_ui_toolbar_layout *l)
 {
-    if (!v->hud || !v->ren) return;
+    if (!v->hud || !v->face) return;
     float s = v->ui_scale;
-    rs_render_stats st = rs_render_get_stats(v->ren);
-    uint32_t total = v->cloud->hdr.count;
-    uint32_t drawn = st.splats_drawn ? st.splats_drawn : (v->rendered.max_splats ? v->rendered.max_splats : total);
+    const rouge_stats *st = &v->info;
+    uint32_t total = st->splats;
+    uint32_t drawn = st->splats_drawn ? st->splats_drawn : (v->rendered.max_splats ? v->rendered.max_splats : total);
     int level = 0;
-    for (uint32_t i = 0; i < v->cloud->hdr.lod_count; i++)
-        if (v->cloud->hdr.lods[i] >= drawn) level = (int)i;
+    for (uint32_t i = 0; i < st->lod_count; i++)
+        if (st->lods[i] >= drawn) level = (int)i;
     char lines[4][96];
     snprintf(lines[0], sizeof lines[0], "%.1f ms  %.0f fps", v->frame_ms_avg, v->frame_ms_avg > 0 ? 1000.0 / v->frame_ms_avg : 0.0);
-    snprintf(lines[1], sizeof lines[1], "LOD %d/%u  %uk of %uk splats", level, v->cloud->hdr.lod_count,
+    snprintf(lines[1], sizeof lines[1], "LOD %d/%u  %uk of %uk splats", level, st->lod_count,
              (drawn + 500) / 1000, (total + 500) / 1000);
-    snprintf(lines[2], sizeof lines[2], "%s K=%d  %dx%d", v->view.pipeline == RS_PIPELINE_MOBILE ? "mobile" : "reference",
-             st.kernel_count, v->view.width, v->view.height);
+    snprintf(lines[2], sizeof lines[2], "%s K=%d  %dx%d",
+             v->view.pipeline == ROUGE_PIPELINE_REFERENCE ? "reference" : "mobile", st->kernel_count, v->view.width,
+             v->view.height);
     snprintf(lines[3], sizeof lines[3], "%s", v->rendered_full ? "full quality" : "interactive");
     // The HUD is for developers: the small font keeps it off the face.
     int ts = RS_MAX(1, (int)(s + 0.25f));
@@ -185,9 +185,8 @@ static void draw_loading(vw_viewer *v)
     int ts = RS_MAX(1, (int)(s * 2 + 0.25f));
     char line[600];
     const char *base = strrchr(v->load.path, '/');
-    pthread_mutex_lock(&v->load.mu);
-    uint32_t decoded = v->load.decoded, count = v->load.count;
-    pthread_mutex_unlock(&v->load.mu);
+    rouge_stream_progress p = v->load.stream ? rouge_stream_get_progress(v->load.stream) : (rouge_stream_progress){0};
+    uint32_t decoded = p.decoded, count = p.splats;
     if (count)
         snprintf(line, sizeof line, "Loading %s  %.1f s  %u of %u splats", base ? base + 1 : v->load.path, t, decoded,
                  count);
@@ -201,16 +200,16 @@ static void draw_loading(vw_viewer *v)
 static void draw_env_chips(vw_viewer *v, const rs_ui_toolbar_layout *l)
 {
     float s = v->ui_scale, h = 30 * s, pad = 6 * s, g = 4 * s;
-    int n = rs_env_name_count();
+    int n = rouge_environment_count();
     float w[8] = {0}, total = 0;
     int ts = RS_MAX(1, (int)floorf(s * 2 + 0.25f));  // rs_ui_text_button's label scale
-    for (int i = 0; i < n && i < 8; i++) total += (w[i] = rs_ui_text_width(rs_env_name(i), ts) + 24 * s);
+    for (int i = 0; i < n && i < 8; i++) total += (w[i] = rs_ui_text_width(rouge_environment_name(i), ts) + 24 * s);
     total += g * (float)(n - 1) + 2 * pad;
     rs_ui_rect panel = {l->top.x + (l->top.w - total) * 0.5f, l->top.y + l->top.h + 6 * s, total, h + 2 * pad};
     rs_ui_panel(v->ui, panel, (h + 2 * pad) * 0.5f);
     float x = panel.x + pad;
     for (int i = 0; i < n && i < 8; i++) {
-        const char *name = rs_env_name(i);
+        const char *name = rouge_environment_name(i);
         bool on = strcmp(name, v->env_name) == 0;
         if (rs_ui_text_button(v->ui, 4100 + i, (rs_ui_rect){x, panel.y + pad, w[i], h}, name, on) && !on)
             vw_set_env(v, name);
@@ -224,7 +223,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
                       .released = v->ui_released, .inside = true};
     v->ui_pressed = v->ui_released = false;
     rs_ui_begin(v->ui, v->fb_w, v->fb_h, v->ui_scale, &in);
-    if (!v->ren) {
+    if (!v->face) {
         draw_loading(v);
         return RS_UI_TOOL_NONE;
     }
@@ -258,8 +257,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
     rs_ui_toolbar_layout_compute(v->fb_w, v->fb_h, v->ui_scale, n, &l);
     if (v->split) draw_split_divider(v, &l);
     // The brush as a person measures it: its diameter on the face in mm, and its opacity in percent.
-    const rs_splat_header *h = &v->cloud->hdr;
-    snprintf(v->size_text, sizeof v->size_text, "%.0f mm", v->size_rel * h->face_height * h->mm_per_unit);
+    snprintf(v->size_text, sizeof v->size_text, "%.0f mm", v->size_rel * v->info.face_height_mm);
     snprintf(v->opacity_text, sizeof v->opacity_text, "%.0f%%", v->opacity * 100.0f);
     *st = (rs_ui_toolbar_state){
         .swatch_count = n, .swatch_rgb = (const uint8_t(*)[3])v->swatch_rgb,
@@ -269,9 +267,9 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         .opacity_text = v->opacity_text,
         .light = {v->light_dial[0], v->light_dial[1]}, .paint = v->paint_mode, .eraser = v->eraser,
         .mirror = v->mirror, .keep_region = !v->any_region, .split = v->split, .hud = v->hud, .help = v->help,
-        .can_undo = rs_makeup_can_undo(v->mk), .can_redo = rs_makeup_can_redo(v->mk),
-        .mode = v->view.mode == RS_MODE_ALBEDO ? 0 : v->view.mode == RS_MODE_DIFFUSE ? 1 : 2,
-        .mobile = v->view.pipeline == RS_PIPELINE_MOBILE,
+        .can_undo = v->info.can_undo, .can_redo = v->info.can_redo,
+        .mode = v->view.mode == ROUGE_MODE_ALBEDO ? 0 : v->view.mode == ROUGE_MODE_DIFFUSE ? 1 : 2,
+        .mobile = v->view.pipeline != ROUGE_PIPELINE_REFERENCE,
     };
     rs_ui_tool t = rs_ui_toolbar(v->ui, &l, st, swatch);
     // The product editor's chip at the swatch row's top right, and the editor when open.

@@ -64,9 +64,9 @@ static void edited(vw_viewer *v)
 static void set_rgb_from_hsv(vw_viewer *v)
 {
     vw_editor *e = &v->editor;
-    rs_cosmetic_hsv_to_rgb(e->hsv[0], e->hsv[1], e->hsv[2], e->product.rgb);
-    // A product that had no colour (gloss, clear powder) gets one once a colour is chosen.
-    if (e->product.colour_weight < 0.5f) e->product.colour_weight = 0.8f;
+    uint8_t rgb[3];
+    rs_cosmetic_hsv_to_rgb(e->hsv[0], e->hsv[1], e->hsv[2], rgb);
+    rs_cosmetic_set_rgb(&e->product, rgb);
     edited(v);
 }
 
@@ -115,9 +115,8 @@ bool vw_editor_key(vw_viewer *v, int key, int mods)
         if (key == GLFW_KEY_ENTER || key == GLFW_KEY_KP_ENTER) {
             uint8_t rgb[3];
             if (parse_hex(e->hex, rgb)) {
-                memcpy(e->product.rgb, rgb, 3);
+                rs_cosmetic_set_rgb(&e->product, rgb);
                 rs_cosmetic_rgb_to_hsv(rgb, &e->hsv[0], &e->hsv[1], &e->hsv[2]);
-                if (e->product.colour_weight < 0.5f) e->product.colour_weight = 0.8f;
                 edited(v);
             } else {
                 vw_toast(v, true, "Colour: six hex digits, like b03050 (got '%s')", e->hex);

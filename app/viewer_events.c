@@ -210,10 +210,10 @@ static rs_result parse_line(parser *p, char **tok, int n)
     }
     if (!strcmp(c, "touch")) {
         if (n != 5 || !rs_parse_number(tok[1], 1, 9, &a[0]) || a[0] != floor(a[0])) return BAD("expected ID (1..9) down|move|up X Y");
-        rs_input_type t;
-        if (!strcmp(tok[2], "down")) t = RS_INPUT_DOWN;
-        else if (!strcmp(tok[2], "move")) t = RS_INPUT_MOVE;
-        else if (!strcmp(tok[2], "up")) t = RS_INPUT_UP;
+        rouge_pointer_type t;
+        if (!strcmp(tok[2], "down")) t = ROUGE_POINTER_DOWN;
+        else if (!strcmp(tok[2], "move")) t = ROUGE_POINTER_MOVE;
+        else if (!strcmp(tok[2], "up")) t = ROUGE_POINTER_UP;
         else return BAD("expected down, move or up");
         if (!rs_parse_number(tok[3], -COORD_MAX, COORD_MAX, &a[1]) || !rs_parse_number(tok[4], -COORD_MAX, COORD_MAX, &a[2]))
             return BAD("coordinates must be numbers");

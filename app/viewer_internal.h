@@ -11,12 +11,9 @@
 
 #include "cli.h"
 #include "core/core.h"
-#include "paint/input.h"
-#include "makeup/makeup.h"
-#include "paint/paint.h"
-#include "render/render.h"
 #include "formats/looklib.h"
-#include "formats/strokes.h"
+#include "makeup/cosmetics.h"
+#include "rouge.h"
 #include "ui.h"
 #include "window.h"
 
@@ -47,7 +44,7 @@ typedef struct vw_event {
     float dy;
     int key, mods;
     int id;                // touch pointer id
-    rs_input_type touch;   // RS_INPUT_DOWN / MOVE / UP
+    rouge_pointer_type touch;  // ROUGE_POINTER_DOWN / MOVE / UP
     char path[512];        // VW_DROP
 } vw_event;
 
@@ -148,23 +145,20 @@ bool vw_key_from_name(const char *name, int *key, int *mods);
 
 // --- the viewer's state (viewer.c owns it; viewer_draw.c reads it and draws) -------------------------
 
-// The face loading on a thread: the file (or standard input for "-") fed piece by piece to an
-// rs_splat_loader. Between pieces the thread publishes a preview cloud of each LOD level that completes
-// (the first at once, then at most one every VW_PREVIEW_EVERY_S), which the frame loop shows while
-// the rest arrives; `cloud` is the whole face once `done`.
+// The face loading on a thread: the file (or standard input for "-") fed piece by piece to a
+// rouge_stream. The frame loop shows a preview face of the LOD levels that have arrived (the first at
+// once, then at most one every VW_PREVIEW_EVERY_S) while the rest arrives, then the whole face once `done`.
 typedef struct vw_loader {
     pthread_t thread;
     bool running;
     bool initial;                 // the face named on the command line: failing to load it is fatal
     atomic_bool done, cancel;
     char path[512];
-    rs_splat_cloud *cloud;
-    rs_result result;
-    rs_error err;
-    double t0;
-    pthread_mutex_t mu;           // guards the three fields below
-    rs_splat_cloud *preview;      // the newest preview not yet taken by the frame loop
-    uint32_t decoded, count;      // progress for the loading line (splats)
+    rouge_stream *stream;
+    rouge_result result;          // the reading thread's, once done
+    rouge_error err;
+    double t0, last_preview;
+    uint32_t shown;               // splats of the face on screen made from the stream (0: none)
 } vw_loader;
 
 // The look library (viewer_looks.c).
@@ -191,8 +185,8 @@ typedef struct vw_looks {
     int confirm_delete;         // the entry whose delete waits for a second tap, -1 none
     rs_ui_texture thumb[VW_LOOKS_PAGE_MAX];
     int thumb_page;             // the page those textures show, -1 none
-    char compare[RS_LOOKLIB_NAME_MAX + 1];  // the look in the split's left half; "" = the bare face
-    rs_makeup *cmp;             // its layer (on the face's cloud)
+    char compare[RS_LOOKLIB_NAME_MAX + 1];  // the look in the split's left half (the face holds it as its
+                                            // compare look); "" = the bare face
     bool compare_dirty;         // the left half must be rendered again
 } vw_looks;
 
@@ -227,12 +221,9 @@ typedef struct vw_viewer {
     vw_script script;
     bool have_script;
 
-    // The face.
-    rs_splat_cloud *cloud;
-    rs_renderer *ren;
-    rs_makeup *mk;
-    rs_paint *paint;
-    rs_paint_picker picker;
+    // The face: everything rendered and painted goes through the public API, as in any host.
+    rouge_face *face;
+    rouge_stats info;           // its splat counts, LOD levels and size (refreshed each frame)
     char face_path[512];
     vw_loader load;
     bool partial;  // the face shown is a preview of a file still loading: painting waits for the rest
@@ -245,9 +236,8 @@ typedef struct vw_viewer {
     int saved_pos[2], saved_size[2];
 
     // Camera, light and what is shown.
-    rs_view view;
-    rs_env *env_cpu;            // the lighting environment (kept to upload into a newly opened face)
-    char env_name[600];         // its name as chosen (a bundled name, "paper" or a .rse path)
+    rouge_view view;            // view.env points at env_name
+    char env_name[600];         // the lighting as chosen (a bundled name, "paper" or a .rse path)
     char env_dir[600];          // <bin>/../share/rouge/env
     float light_dial[2];
     bool split, hud, help, paint_mode;
@@ -273,7 +263,7 @@ typedef struct vw_viewer {
     // Rendering state.
     bool dirty_view;            // camera/light/mode changed: both halves of the split are stale
     bool dirty_makeup;          // the made-up half is stale
-    vw_rung rungs[RS_SPLAT_MAX_LODS + 4];  // interactive quality ladder, best first
+    vw_rung rungs[ROUGE_MAX_LODS + 4];  // interactive quality ladder, best first
     int rung_count, rung;       // the rung interactive frames use (adapted to the frame-time budget)
     vw_rung rendered;              // quality of the picture on screen (max_splats 0 = full)
     bool rendered_full;
@@ -287,8 +277,6 @@ typedef struct vw_viewer {
     // Files.
     vw_looks looks;
     vw_editor editor;
-    rs_strokes *rec;
-    bool rec_unsaved;           // strokes recorded since the file was last written (saved when idle)
     int shot_counter;
     char toast[256];
     bool toast_error;
@@ -316,11 +304,11 @@ bool vw_set_env(vw_viewer *v, const char *name);
 float vw_size_to_slider(float size_rel);
 // Where the current product's brush stays ("lips", "eyes", "skin"), NULL when it paints anywhere.
 const char *vw_brush_region(const vw_viewer *v);
-// The picker on the picture as shown: framebuffer pixels in, whatever resolution it was rendered at.
-bool vw_pick(void *viewer, float x_px, float y_px, uint32_t *splat_index, float hit[3]);
-float vw_pixels_per_unit(void *viewer, const float pos[3]);
+// The face under framebuffer pixel (x, y) of the picture as shown, whatever resolution it was rendered
+// at; the brush radius in framebuffer pixels.
+bool vw_pick(vw_viewer *v, float x_px, float y_px, rouge_pick *out);
 
-// Loads a look file into the face (undo history restarts), uploads it; toasts and returns failures.
+// Loads a look file into the face (undo history restarts); toasts and returns failures.
 rs_result vw_load_look_file(vw_viewer *v, const char *path, rs_error *err);
 
 // viewer_looks.c
@@ -335,9 +323,6 @@ void vw_looks_char(vw_viewer *v, unsigned codepoint);
 void vw_looks_draw(vw_viewer *v);           // into v->ui, after the rest; handles its taps
 void vw_looks_forget_face(vw_viewer *v);    // another face was opened
 bool vw_looks_comparing(const vw_viewer *v);
-// Renders the view with the compared look into the renderer's output (the split's left half), then
-// puts the current look back on the GPU.
-rs_result vw_looks_render_compared(vw_viewer *v, rs_error *err);
 
 // viewer.c: the brush from the current product, size, opacity, eraser, mirror, region toggle.
 void vw_apply_brush(vw_viewer *v);

@@ -5,7 +5,6 @@
 #define _POSIX_C_SOURCE 200809L
 #include "app.h"
 #include "viewer_internal.h"
-#include "formats/look.h"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -84,8 +83,6 @@ void vw_looks_free(vw_viewer *v)
     drop_thumbs(L);
     free(L->entries);
     L->entries = NULL, L->count = 0;
-    rs_makeup_destroy(L->cmp);
-    L->cmp = NULL;
 }
 
 // Re-reads the library (after a save or delete, or when the sheet opens).
@@ -137,24 +134,32 @@ static void end_save(vw_viewer *v)
     if (L->back_to_sheet) vw_looks_open(v);
 }
 
-// The thumbnail: the face with this look, frontal, framed brows to chin (RS_APP_THUMB_*), in the
-// current lighting. Then the picture on screen must be redrawn (the renderer's output held the thumbnail).
+// The thumbnail: the face with this look, frontal, framed brows to chin (rs_app_thumbnail_view, as
+// `rouge looks save` frames it), in the current lighting. Then the picture on screen must be redrawn (the
+// face's last frame is the thumbnail).
 static rs_result render_thumbnail(vw_viewer *v, rs_image *out, rs_error *err)
 {
-    rs_view tv = v->view;
-    tv.width = RS_LOOKLIB_THUMB_W, tv.height = RS_LOOKLIB_THUMB_H;
+    rouge_view tv = v->view, shot = rs_app_thumbnail_view();
+    tv.width = shot.width, tv.height = shot.height;
     tv.yaw_deg = tv.pitch_deg = 0;
-    tv.zoom = RS_APP_THUMB_ZOOM;
-    tv.pan[0] = 0, tv.pan[1] = RS_APP_THUMB_PAN_Y;
+    tv.zoom = shot.zoom;
+    tv.pan[0] = shot.pan[0], tv.pan[1] = shot.pan[1];
     tv.max_splats = 0;
-    tv.hide_makeup = false;
-    tv.mode = RS_MODE_FULL;
+    tv.hide_makeup = tv.compare_look = false;
+    tv.mode = ROUGE_MODE_FULL;
+    tv.env = v->env_name;
+    rouge_error e = {0};
     rs_image img = {0};
-    rs_result r = rs_render_image(v->ren, &tv, &img, err);
-    rs_render_invalidate(v->ren);
+    rouge_result r = rouge_face_set_view(v->face, &tv, &e);
+    if (!r) r = rouge_face_render(v->face, &e);
+    if (!r && rs_image_create(tv.width, tv.height, 4, &img, err) != RS_OK) r = (rouge_result)err->code, snprintf(e.msg, sizeof e.msg, "%s", err->msg);
+    if (!r) r = rouge_face_read_rgba(v->face, img.pixels, (size_t)img.width * img.height * 4, &e);
     v->dirty_view = true;
     v->looks.compare_dirty = true;
-    if (r) return r;
+    if (r) {
+        rs_image_free(&img);
+        return rs_fail(err, (rs_result)r, "%s", e.msg);
+    }
     uint8_t *d = img.pixels;
     for (size_t i = 0; i < (size_t)img.width * img.height; i++, d += 3) memmove(d, img.pixels + i * 4, 3);
     img.channels = 3;
@@ -177,10 +182,12 @@ static void save(vw_viewer *v, bool overwrite)
     char *text = NULL;
     size_t len = 0;
     rs_image thumb = {0};
-    rs_result r = rs_look_write_memory(v->mk, &text, &len, &err);
+    rouge_error e = {0};
+    rs_result r = RS_OK;
+    if (rouge_face_save_look_memory(v->face, &text, &len, &e) != ROUGE_OK) r = rs_fail(&err, (rs_result)e.code, "%s", e.msg);
     if (!r) r = render_thumbnail(v, &thumb, &err);
     if (!r) r = rs_looklib_save(L->dir, L->name, text, len, &thumb, overwrite, &err);
-    free(text);
+    rouge_free(text);
     rs_image_free(&thumb);
     if (r == RS_ERR_ARG && !overwrite && rs_looklib_exists(L->dir, L->name)) {
         L->clash = true;  // another viewer saved this name meanwhile
@@ -214,11 +221,12 @@ static void compare(vw_viewer *v, int i)
     rs_error err = {0};
     if (i < 0) {
         L->compare[0] = 0;
+        rouge_face_set_compare_look(v->face, NULL, NULL);
     } else {
         char path[1100];
         rs_result r = rs_looklib_path(L->dir, L->entries[i].name, false, path, sizeof path, &err);
-        if (!r && !L->cmp) r = rs_makeup_create(v->cloud, NULL, &L->cmp, &err);
-        if (!r) r = rs_look_load(L->cmp, path, NULL, &err);
+        rouge_error e = {0};
+        if (!r && rouge_face_set_compare_look(v->face, path, &e) != ROUGE_OK) r = rs_fail(&err, (rs_result)e.code, "%s", e.msg);
         if (r) {
             vw_toast(v, true, "%s", err.msg);
             return;
@@ -246,15 +254,17 @@ static void delete_at(vw_viewer *v, int i)
     snprintf(name, sizeof name, "%s", L->entries[i].name);
     if (rs_looklib_remove(L->dir, name, &err) != RS_OK) vw_toast(v, true, "%s", err.msg);
     else vw_toast(v, false, "Deleted look '%s'", name);
-    if (!strcmp(name, L->compare)) L->compare[0] = 0, L->compare_dirty = true, v->dirty_view = true;
+    if (!strcmp(name, L->compare)) {
+        // Its file is gone: the left half shows the bare face again.
+        L->compare[0] = 0, L->compare_dirty = true, v->dirty_view = true;
+        rouge_face_set_compare_look(v->face, NULL, NULL);
+    }
     refresh(v);
 }
 
 void vw_looks_forget_face(vw_viewer *v)
 {
-    // Another face: the compared layer belonged to the old cloud.
-    rs_makeup_destroy(v->looks.cmp);
-    v->looks.cmp = NULL;
+    // Another face: the compared look was loaded into the old one.
     v->looks.compare[0] = 0;
 }
 
@@ -470,18 +480,4 @@ void vw_looks_draw(vw_viewer *v)
     rs_ui_area(v->ui, ID_BASE + 7, (rs_ui_rect){0, 0, (float)v->fb_w, (float)v->fb_h});
 }
 
-// --- the split's compared half --------------------------------------------------------------------------------
-
-rs_result vw_looks_render_compared(vw_viewer *v, rs_error *err)
-{
-    vw_looks *L = &v->looks;
-    uint32_t n = rs_makeup_count(v->mk);
-    // The renderer holds one makeup layer: show the compared look's, render, then put the current back.
-    rs_result r = rs_render_update_makeup(v->ren, 0, n, rs_makeup_records(L->cmp), err);
-    if (!r) r = rs_render_frame(v->ren, &v->view, err);
-    rs_result r2 = rs_render_update_makeup(v->ren, 0, n, rs_makeup_records(v->mk), err);
-    L->compare_dirty = false;
-    return r ? r : r2;
-}
-
-bool vw_looks_comparing(const vw_viewer *v) { return v->looks.compare[0] && v->looks.cmp; }
+bool vw_looks_comparing(const vw_viewer *v) { return v->looks.compare[0] != 0; }

@@ -151,6 +151,8 @@ typedef struct rouge_view {
     float background[4];         // sRGB 0..1 + alpha; alpha 0 = the default dark grey
     bool no_shadows;
     bool hide_makeup;            // the bare face (a before / after comparison)
+    bool compare_look;           // the look set with rouge_face_set_compare_look instead of the painted one
+                                 // (the bare face while none is set): two looks side by side
     float specular_scale;        // multiplies the skin's specular; 0 = 1 (2 = oily skin)
     uint32_t max_splats;         // cap on the splats drawn (an LOD prefix); 0 = the pipeline decides
     int kernel_count;            // mobile: Gaussians of the subsurface profile (2..4); 0 = 3
@@ -158,14 +160,21 @@ typedef struct rouge_view {
     rouge_primitive primitive;   // how splats are rasterised (a debugging choice; both agree)
 } rouge_view;
 
+// The bundled lighting environments ("studio", "daylight", ...) a view's env may name, then "paper";
+// NULL when i is out of range.
+int rouge_environment_count(void);
+const char *rouge_environment_name(int i);
+
 // --- the face ------------------------------------------------------------------------------------------
 
 typedef struct rouge_face rouge_face;
+typedef struct rouge_stream rouge_stream;
 
 typedef struct rouge_face_desc {
     const char *path;            // a .rsf file; or
-    const void *data;            // the bytes of one (not kept after create)
+    const void *data;            // the bytes of one (not kept after create); or
     size_t size;
+    rouge_stream *stream;        // a file still arriving (below): the face so far, or all of it
     const rouge_view *view;      // the initial view; NULL = (rouge_view){0}
     uint32_t undo_levels;        // strokes kept for undo; 0 = 64
     bool manual_navigation;      // pointer gestures only report orbit / pan / zoom, the camera stays
@@ -176,6 +185,28 @@ typedef struct rouge_face_desc {
 
 // Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
 rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, rouge_error *err);
+
+// A large face over a slow disk or network: feed the file's bytes as they arrive (one thread feeds; any
+// thread may ask for progress and create faces meanwhile, the stream locks itself). A .rsf v2 file
+// stores its coarse LOD levels first, so a face made from a stream still arriving is a preview: the
+// complete LOD levels so far (rouge_stream_progress().ready splats), drawn closed at that density. Once
+// the stream is complete a face made from it takes all the splats (the stream hands them over: a second
+// face from it is ROUGE_ERR_ARG). Version 1 files show nothing before they are complete.
+typedef struct rouge_stream_progress {
+    uint64_t bytes;              // fed so far
+    uint32_t splats;             // the face's splat count once the header has arrived, else 0
+    uint32_t decoded;            // splats decoded and checked
+    uint32_t ready;              // splats a preview would show (a LOD prefix), 0 while none
+    bool complete;               // every byte has arrived: a face from the stream is the whole face
+} rouge_stream_progress;
+
+// `name` names the stream in messages (NULL = "(stream)"); total_bytes is the file's size when known
+// (checked against the header before anything is allocated), 0 when not.
+rouge_result rouge_stream_create(const char *name, uint64_t total_bytes, rouge_stream **out, rouge_error *err);
+// The next bytes. Errors (malformed or surplus bytes) are sticky: every later call repeats the first.
+rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, rouge_error *err);
+rouge_stream_progress rouge_stream_get_progress(rouge_stream *s);
+void rouge_stream_destroy(rouge_stream *s);  // NULL is fine; faces made from it keep their splats
 // With the creating context current. NULL is fine.
 void rouge_face_destroy(rouge_face *face);
 
@@ -245,9 +276,22 @@ typedef enum rouge_pressure {
     ROUGE_PRESSURE_NONE,
 } rouge_pressure;
 
+typedef enum rouge_finish {
+    ROUGE_FINISH_DEFAULT = 0,    // the product's own
+    ROUGE_FINISH_MATTE,          // rough, dull: powder
+    ROUGE_FINISH_SATIN,          // about the skin's own sheen
+    ROUGE_FINISH_GLOSS,          // smooth with a clear coat: sharp reflections (lip gloss)
+    ROUGE_FINISH_SHIMMER,        // pigment-tinted flakes that glint (highlighter)
+} rouge_finish;
+
 typedef struct rouge_brush {
     const char *cosmetic;        // a preset name (rouge_cosmetic_get); NULL = "foundation_1"
-    float color[3];              // sRGB 0..1 replacing the preset's colour (its finish kept); all 0 = the preset's
+    // A custom product made from the preset (it keeps the preset's kind, region and brush; looks record it
+    // as "custom_<preset>"):
+    float color[4];              // sRGB 0..1 + alpha: alpha > 0 replaces the colour (a colourless product, a
+                                 // gloss, gains one); alpha 0 = the preset's colour
+    rouge_finish finish;         // 0 = the preset's
+    float coverage;              // 0 = the preset's; else sheer 0..1 opaque (negative = 0, fully sheer)
     float size;                  // diameter as a fraction of the face height; 0 = the cosmetic's
     float opacity;               // 0..1; 0 = the cosmetic's
     rouge_pressure pressure;
@@ -264,6 +308,9 @@ typedef struct rouge_cosmetic {
     const char *kind;            // "lipstick"
     uint8_t rgb[3];              // sRGB
     float size, opacity;         // its default brush
+    rouge_finish finish;         // the family nearest to its finish (never DEFAULT)
+    float coverage;              // sheer 0..1 opaque
+    const char *region;          // where its brush stays: "lips", "eyes", "skin", or NULL: anywhere
 } rouge_cosmetic;
 
 int rouge_cosmetic_count(void);
@@ -287,6 +334,9 @@ rouge_result rouge_face_load_look_memory(rouge_face *face, const void *data, siz
 rouge_result rouge_face_save_look(rouge_face *face, const char *path, rouge_error *err);
 // *data (free with rouge_free) holds *size bytes of look text.
 rouge_result rouge_face_save_look_memory(rouge_face *face, char **data, size_t *size, rouge_error *err);
+// The second look for comparisons (drawn when the view's compare_look is set): a look file, or NULL for
+// none (the bare face). It is only shown, never painted. On failure the previous one stays.
+rouge_result rouge_face_set_compare_look(rouge_face *face, const char *path, rouge_error *err);
 // Records each stroke painted from now on to a stroke file; NULL stops. After every stroke the whole
 // recording is rewritten atomically on a background thread (never a half-written file, and no disk wait
 // on the pointer path); a failed write is returned by a later rouge_face_pointer, rouge_face_flush_strokes

@@ -156,6 +156,16 @@ struct rouge_face {
     rs_strokes *rec;              // stroke recording (rouge_face_record_strokes)
     rec_writer *writer;           // writes it to its file off the pointer path
     uint32_t uploaded;            // records uploaded for the last frame
+    rs_makeup *cmp;               // the compared look (rouge_face_set_compare_look), NULL = bare
+};
+
+// A file arriving piece by piece: the splat loader behind a lock (one thread feeds, the GL thread makes
+// faces from it).
+struct rouge_stream {
+    pthread_mutex_t mu;
+    rs_splat_loader *ld;
+    uint64_t bytes;
+    bool taken;                   // a complete stream's splats went to a face
 };
 
 static rouge_result fail_out(rouge_error *out, const rs_error *e)
@@ -182,6 +192,75 @@ const char *rouge_result_name(rouge_result r)
 }
 
 void rouge_free(void *p) { free(p); }
+
+int rouge_environment_count(void) { return rs_env_name_count(); }
+const char *rouge_environment_name(int i) { return rs_env_name(i); }
+
+// --- streams ---------------------------------------------------------------------------------------------
+
+rouge_result rouge_stream_create(const char *name, uint64_t total_bytes, rouge_stream **out, rouge_error *err)
+{
+    rs_error e = {0};
+    if (!out) return fail_arg(err, "stream: out is required");
+    rouge_stream *s = calloc(1, sizeof *s);
+    if (!s) return rs_fail(&e, RS_ERR_NOMEM, "stream: out of memory"), fail_out(err, &e);
+    if (rs_splat_loader_create(&(rs_splat_loader_desc){.name = name, .total_bytes = total_bytes}, &s->ld, &e)) {
+        free(s);
+        return fail_out(err, &e);
+    }
+    pthread_mutex_init(&s->mu, NULL);
+    *out = s;
+    return ROUGE_OK;
+}
+
+rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, rouge_error *err)
+{
+    rs_error e = {0};
+    pthread_mutex_lock(&s->mu);
+    rs_result r = s->taken ? rs_fail(&e, RS_ERR_ARG, "stream: already handed to a face") : rs_splat_loader_feed(s->ld, data, size, &e);
+    if (!r) s->bytes += size;
+    pthread_mutex_unlock(&s->mu);
+    return r ? fail_out(err, &e) : ROUGE_OK;
+}
+
+rouge_stream_progress rouge_stream_get_progress(rouge_stream *s)
+{
+    pthread_mutex_lock(&s->mu);
+    const rs_splat_header *h = rs_splat_loader_header(s->ld);
+    rouge_stream_progress p = {.bytes = s->bytes, .splats = h ? h->count : 0,
+                               .decoded = rs_splat_loader_decoded(s->ld), .ready = rs_splat_loader_ready(s->ld),
+                               .complete = rs_splat_loader_complete(s->ld)};
+    pthread_mutex_unlock(&s->mu);
+    return p;
+}
+
+void rouge_stream_destroy(rouge_stream *s)
+{
+    if (!s) return;
+    rs_splat_loader_destroy(s->ld);
+    pthread_mutex_destroy(&s->mu);
+    free(s);
+}
+
+// The cloud a face gets from a stream: all of it once complete (handed over), else a preview of the
+// complete LOD levels.
+static rs_result stream_cloud(rouge_stream *s, rs_splat_cloud **out, rs_error *e)
+{
+    pthread_mutex_lock(&s->mu);
+    rs_result r;
+    if (s->taken) {
+        r = rs_fail(e, RS_ERR_ARG, "stream: its splats already went to a face");
+    } else if (rs_splat_loader_complete(s->ld)) {
+        r = rs_splat_loader_finish(s->ld, out, e);
+        s->taken = r == RS_OK;
+    } else {
+        uint32_t ready = rs_splat_loader_ready(s->ld);
+        r = ready ? rs_splat_loader_preview(s->ld, ready, out, e)
+                  : rs_fail(e, RS_ERR_ARG, "stream: no LOD level has arrived yet");
+    }
+    pthread_mutex_unlock(&s->mu);
+    return r;
+}
 
 // --- the host's GL state -------------------------------------------------------------------------------------
 
@@ -566,7 +645,8 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
 {
     rs_error e = {0};
     if (!desc || !out) return fail_arg(err, "rouge_face_create: desc and out are required");
-    if (!desc->path && !desc->data) return fail_arg(err, "rouge_face_create: desc needs a path or data");
+    if (!desc->path && !desc->data && !desc->stream)
+        return fail_arg(err, "rouge_face_create: desc needs a path, data or a stream");
     rs_gl_caps caps = {0};
     if (rs_gl_query_caps(&caps, &e) != RS_OK) return fail_out(err, &e);
     rouge_face *f = calloc(1, sizeof *f);
@@ -581,8 +661,9 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
         }
         memcpy(f->env_dir, desc->env_dir, n);
     }
-    rs_result r = desc->path ? rs_splat_load(desc->path, &f->cloud, &e)
-                             : rs_splat_load_memory(desc->data, desc->size, &f->cloud, &e);
+    rs_result r = desc->path     ? rs_splat_load(desc->path, &f->cloud, &e)
+                  : desc->stream ? stream_cloud(desc->stream, &f->cloud, &e)
+                                 : rs_splat_load_memory(desc->data, desc->size, &f->cloud, &e);
     gl_saved s;
     gl_save(&s);
     if (!r)
@@ -618,6 +699,7 @@ void rouge_face_destroy(rouge_face *f)
     free(f->env_dir);
     rs_paint_destroy(f->paint);
     rs_makeup_destroy(f->mk);
+    rs_makeup_destroy(f->cmp);
     if (f->ren) {
         gl_saved s;
         gl_save(&s);
@@ -652,7 +734,21 @@ static rs_result render_at(rouge_face *f, int w, int h, rs_error *e)
 {
     rs_result r = flush_makeup(f, e);
     rs_view v = to_rs_view(&f->view, w, h);
-    if (!r) r = rs_render_frame(f->ren, &v, e);
+    if (!r && f->view.compare_look && f->cmp) {
+        // The renderer holds one makeup layer: the compared look's for this frame, then the painted one's
+        // back (both whole: the next frame is drawn in full, no dirty rectangle to gather).
+        uint32_t n = rs_makeup_count(f->mk);
+        rs_render_invalidate(f->ren);
+        r = rs_render_update_makeup(f->ren, 0, n, rs_makeup_records(f->cmp), e);
+        if (!r) r = rs_render_frame(f->ren, &v, e);
+        rs_render_invalidate(f->ren);
+        rs_error e2 = {0};
+        rs_result r2 = rs_render_update_makeup(f->ren, 0, n, rs_makeup_records(f->mk), &e2);
+        if (!r && r2) r = r2, *e = e2;
+    } else {
+        if (f->view.compare_look) v.hide_makeup = true;  // no look to compare with: the bare face
+        if (!r) r = rs_render_frame(f->ren, &v, e);
+    }
     if (r) return r;
     f->frame_view = v;
     f->have_frame = true;
@@ -745,8 +841,11 @@ bool rouge_cosmetic_get(int i, rouge_cosmetic *out)
 {
     const rs_cosmetic *c = i >= 0 ? rs_cosmetic_get((uint32_t)i) : NULL;
     if (!c) return false;
+    rs_cosmetic_region reg = rs_cosmetic_region_of(c);
     *out = (rouge_cosmetic){.name = c->name, .kind = rs_cosmetic_kind_name(c->kind), .size = c->size_rel,
-                            .opacity = c->opacity};
+                            .opacity = c->opacity, .finish = (rouge_finish)(rs_cosmetic_finish(c) + 1),
+                            .coverage = c->coverage,
+                            .region = reg == RS_COSMETIC_REGION_ANY ? NULL : rs_cosmetic_region_name(reg)};
     memcpy(out->rgb, c->rgb, 3);
     return true;
 }
@@ -764,14 +863,23 @@ rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge
     if ((unsigned)b.pressure > ROUGE_PRESSURE_NONE) return fail_arg(err, "brush: unknown pressure map");
     if (!(b.size >= 0 && b.size <= 2) || !(b.opacity >= 0 && b.opacity <= 1))
         return fail_arg(err, "brush: size must be 0..2 (face heights), opacity 0..1");
+    if ((unsigned)b.finish > ROUGE_FINISH_SHIMMER) return fail_arg(err, "brush: unknown finish");
+    if (!(b.coverage <= 1) || !(b.color[3] >= 0)) return fail_arg(err, "brush: coverage must be <= 1, colour alpha >= 0");
     rs_paint_brush pb = {.cosmetic = *c, .size_rel = b.size, .opacity = b.opacity,
                          .pressure = (rs_makeup_pressure)b.pressure, .eraser = b.eraser, .mirror = b.mirror,
                          .any_region = b.any_region};
-    if (!all_zero(b.color, sizeof b.color)) {
-        pb.cosmetic.region_mask = rs_cosmetic_region_of(c);  // a recoloured lipstick still belongs on the lips
-        for (int i = 0; i < 3; i++) pb.cosmetic.rgb[i] = (uint8_t)lroundf(RS_CLAMP(b.color[i], 0.0f, 1.0f) * 255.0f);
-        snprintf(pb.cosmetic.name, sizeof pb.cosmetic.name, "custom");
-        pb.cosmetic.kind = RS_COSMETIC_CUSTOM;
+    if (b.color[3] > 0 || b.finish != ROUGE_FINISH_DEFAULT || b.coverage != 0) {
+        // A custom product of the preset's kind: a recoloured lipstick still belongs on the lips.
+        rs_cosmetic *pc = &pb.cosmetic;
+        pc->region_mask = rs_cosmetic_region_of(c);
+        if (b.color[3] > 0) {
+            uint8_t rgb[3];
+            for (int i = 0; i < 3; i++) rgb[i] = (uint8_t)lroundf(RS_CLAMP(b.color[i], 0.0f, 1.0f) * 255.0f);
+            rs_cosmetic_set_rgb(pc, rgb);
+        }
+        if (b.finish != ROUGE_FINISH_DEFAULT) rs_cosmetic_set_finish(pc, (rs_finish)(b.finish - 1));
+        if (b.coverage != 0) pc->coverage = RS_CLAMP(b.coverage, 0.0f, 1.0f);
+        snprintf(pc->name, sizeof pc->name, "custom_%.*s", (int)sizeof pc->name - 8, c->name);
     }
     rs_paint_set_brush(f->paint, &pb);
     return ROUGE_OK;
@@ -888,6 +996,28 @@ rouge_result rouge_face_save_look_memory(rouge_face *f, char **data, size_t *siz
     rs_error e = {0};
     if (!data || !size) return fail_arg(err, "look: data and size are required");
     return rs_look_write_memory(f->mk, data, size, &e) ? fail_out(err, &e) : ROUGE_OK;
+}
+
+rouge_result rouge_face_set_compare_look(rouge_face *f, const char *path, rouge_error *err)
+{
+    rs_error e = {0};
+    if (!path) {
+        rs_makeup_destroy(f->cmp);
+        f->cmp = NULL;
+        f->changed = true;
+        return ROUGE_OK;
+    }
+    rs_makeup *mk = NULL;
+    rs_result r = rs_makeup_create(f->cloud, NULL, &mk, &e);
+    if (!r) r = rs_look_load(mk, path, NULL, &e);
+    if (r) {
+        rs_makeup_destroy(mk);
+        return fail_out(err, &e);
+    }
+    rs_makeup_destroy(f->cmp);
+    f->cmp = mk;
+    f->changed = true;
+    return ROUGE_OK;
 }
 
 rouge_result rouge_face_record_strokes(rouge_face *f, const char *path, rouge_error *err)

@@ -372,6 +372,148 @@ static void test_pan_shifts_the_picture(void)
     rouge_face_set_view(face, &v, &e);
 }
 
+
+// A face from a stream: before any LOD level nothing; mid-stream a preview of the complete levels (fewer
+// splats, drawable); complete, the whole face, identical to one loaded from the file; the stream is
+// handed over once; hostile bytes fail and stay failed.
+static void test_stream_previews_then_the_whole_face(void)
+{
+    rouge_error e = {0};
+    void *data = NULL;
+    size_t n = 0;
+    rs_error re = {0};
+    RS_REQUIRE(rs_file_read_all(FACE, 64u << 20, &data, &n, &re) == RS_OK, "%s", re.msg);
+    const uint8_t *bytes = data;
+    rouge_stream *s = NULL;
+    RS_REQUIRE(rouge_stream_create("face", n, &s, &e) == ROUGE_OK, "%s", e.msg);
+    rouge_view v = small_view();
+    v.max_splats = 0;
+    rouge_face *f = NULL;
+    RS_CHECK(rouge_face_create(&(rouge_face_desc){.stream = s, .view = &v}, &f, &e) == ROUGE_ERR_ARG,
+             "a face before any LOD level arrived: %s", e.msg);
+    // Feed in uneven pieces until the first level is ready.
+    size_t at = 0, piece = 7777;
+    while (at < n && rouge_stream_get_progress(s).ready == 0) {
+        size_t k = RS_MIN(piece, n - at);
+        RS_REQUIRE(rouge_stream_feed(s, bytes + at, k, &e) == ROUGE_OK, "feed at %zu: %s", at, e.msg);
+        at += k;
+    }
+    rouge_stream_progress p = rouge_stream_get_progress(s);
+    RS_CHECK(p.ready > 0 && p.ready < p.splats && !p.complete && p.bytes == at, "progress: ready %u of %u, %llu bytes",
+             p.ready, p.splats, (unsigned long long)p.bytes);
+    if (RS_CHECK(rouge_face_create(&(rouge_face_desc){.stream = s, .view = &v}, &f, &e) == ROUGE_OK, "preview: %s",
+                 e.msg)) {
+        rouge_stats st = rouge_face_stats(f);
+        RS_CHECK(st.splats == p.ready, "the preview holds %u splats, the stream had %u ready", st.splats, p.ready);
+        RS_CHECK(rouge_face_render(f, &e) == ROUGE_OK, "render the preview: %s", e.msg);
+        rouge_face_destroy(f);
+    }
+    RS_REQUIRE(rouge_stream_feed(s, bytes + at, n - at, &e) == ROUGE_OK, "feed the rest: %s", e.msg);
+    RS_CHECK(rouge_stream_get_progress(s).complete, "complete after every byte");
+    f = NULL;
+    if (RS_CHECK(rouge_face_create(&(rouge_face_desc){.stream = s, .view = &v}, &f, &e) == ROUGE_OK, "whole: %s",
+                 e.msg)) {
+        rouge_stats st = rouge_face_stats(f), want = rouge_face_stats(face);
+        RS_CHECK(st.splats == want.splats && st.lod_count == want.lod_count, "whole face %u splats, the file has %u",
+                 st.splats, want.splats);
+        rouge_face *g = NULL;
+        RS_CHECK(rouge_face_create(&(rouge_face_desc){.stream = s, .view = &v}, &g, &e) == ROUGE_ERR_ARG,
+                 "a second face from a handed-over stream: %s", e.msg);
+        rouge_face_destroy(f);
+    }
+    RS_CHECK(rouge_stream_feed(s, bytes, 1, &e) != ROUGE_OK, "bytes after the end are refused");
+    rouge_stream_destroy(s);
+    // Garbage: the first error sticks.
+    RS_REQUIRE(rouge_stream_create(NULL, 0, &s, &e) == ROUGE_OK, "%s", e.msg);
+    RS_CHECK(rouge_stream_feed(s, "not a face file at all, really", 30, &e) == ROUGE_ERR_FORMAT, "garbage: %s", e.msg);
+    RS_CHECK(rouge_stream_feed(s, bytes, 64, &e) == ROUGE_ERR_FORMAT, "the error sticks: %s", e.msg);
+    RS_CHECK(!rouge_stream_get_progress(s).complete, "garbage never completes");
+    rouge_stream_destroy(s);
+    free(data);
+}
+
+// The compare look: drawn instead of the painted one when the view asks; none set = the bare face; the
+// painted look is untouched by it (a frame after one of the compared look is the painted picture).
+static void test_compare_look(void)
+{
+    rouge_view v = small_view();
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .size = 0.15f, .opacity = 1}, &e) == ROUGE_OK,
+               "%s", e.msg);
+    rs_image bare = {0}, a = {0}, b = {0}, cmp_none = {0}, cmp_a = {0}, after = {0};
+    rouge_pointer_result res;
+    const char *dir = getenv("RS_TEST_OUT");
+    char path[512];
+    snprintf(path, sizeof path, "%s/test_face_compare.look", dir ? dir : "/tmp");
+    if (!frame(&bare)) return;
+    RS_REQUIRE(stroke(SIZE * 0.35f, SIZE * 0.6f, SIZE * 0.65f, SIZE * 0.6f, &res) == ROUGE_OK, "stroke a");
+    if (!frame(&a)) goto out;
+    RS_REQUIRE(rouge_face_save_look(face, path, &e) == ROUGE_OK, "%s", e.msg);
+    RS_REQUIRE(rouge_face_clear(face, &e) == ROUGE_OK, "%s", e.msg);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "lipstick_matte", .size = 0.1f, .opacity = 1,
+                                                         .any_region = true}, &e) == ROUGE_OK, "%s", e.msg);
+    RS_REQUIRE(stroke(SIZE * 0.4f, SIZE * 0.4f, SIZE * 0.6f, SIZE * 0.45f, &res) == ROUGE_OK, "stroke b");
+    if (!frame(&b)) goto out;
+    v.compare_look = true;
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    if (!frame(&cmp_none)) goto out;
+    RS_CHECK(same(&cmp_none, &bare), "no compare look: the bare face (%d pixels differ)", changed_pixels(&cmp_none, &bare));
+    RS_CHECK(rouge_face_set_compare_look(face, "no/such.look", &e) == ROUGE_ERR_IO, "missing look: %s", e.msg);
+    RS_REQUIRE(rouge_face_set_compare_look(face, path, &e) == ROUGE_OK, "%s", e.msg);
+    if (!frame(&cmp_a)) goto out;
+    RS_CHECK(same(&cmp_a, &a), "the compare look draws as look a did (%d pixels differ)", changed_pixels(&cmp_a, &a));
+    v.compare_look = false;
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    if (!frame(&after)) goto out;
+    RS_CHECK(same(&after, &b), "the painted look after a compared frame (%d pixels differ)", changed_pixels(&after, &b));
+    RS_CHECK(rouge_face_set_compare_look(face, NULL, &e) == ROUGE_OK, "unset: %s", e.msg);
+out:
+    rouge_face_clear(face, NULL);
+    rs_image_free(&bare), rs_image_free(&a), rs_image_free(&b), rs_image_free(&cmp_none), rs_image_free(&cmp_a);
+    rs_image_free(&after);
+}
+
+// A custom product through the brush: colour (black too: alpha says "given"), finish and coverage
+// reach the look under the preset's name with "custom_"; a zero brush colour keeps the preset's.
+static void test_custom_brush_product(void)
+{
+    rouge_view v = small_view();
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    rs_image img = {0};
+    if (!frame(&img)) return;
+    rs_image_free(&img);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "lip_gloss", .color = {0, 0, 0, 1},
+                                                         .finish = ROUGE_FINISH_MATTE, .coverage = 0.9f,
+                                                         .size = 0.1f, .opacity = 1, .any_region = true}, &e) == ROUGE_OK,
+               "%s", e.msg);
+    rouge_pointer_result res;
+    RS_REQUIRE(stroke(SIZE * 0.4f, SIZE * 0.5f, SIZE * 0.6f, SIZE * 0.5f, &res) == ROUGE_OK, "stroke");
+    char *look = NULL;
+    size_t len = 0;
+    RS_REQUIRE(rouge_face_save_look_memory(face, &look, &len, &e) == ROUGE_OK, "%s", e.msg);
+    RS_CHECK(strstr(look, "custom_lip_gloss") && strstr(look, "rgb=0,0,0") && strstr(look, "coverage=0.89"),
+             "the look carries the custom product: %.300s", look);
+    RS_CHECK(strstr(look, "kind=lip_gloss"), "it keeps the preset's kind: %.300s", look);
+    rouge_free(look);
+    RS_CHECK(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .finish = (rouge_finish)9}, &e) == ROUGE_ERR_ARG,
+             "unknown finish: %s", e.msg);
+    rouge_cosmetic c;
+    bool found = false;
+    for (int i = 0; rouge_cosmetic_get(i, &c); i++)
+        if (!strcmp(c.name, "lip_gloss")) {
+            found = true;
+            RS_CHECK(c.finish == ROUGE_FINISH_GLOSS && c.region && !strcmp(c.region, "lips"), "lip gloss: finish %d, region %s",
+                     c.finish, c.region ? c.region : "(any)");
+        }
+    RS_CHECK(found, "lip_gloss is a preset");
+    RS_CHECK(rouge_environment_count() >= 2 && !strcmp(rouge_environment_name(rouge_environment_count() - 1), "paper") &&
+                 !rouge_environment_name(rouge_environment_count()),
+             "environments end with paper");
+    rouge_face_clear(face, NULL);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -394,6 +536,9 @@ int main(int argc, char **argv)
     RS_RUN(test_errors_are_values);
     RS_RUN(test_target_centres_each_region);
     RS_RUN(test_pan_shifts_the_picture);
+    RS_RUN(test_stream_previews_then_the_whole_face);
+    RS_RUN(test_compare_look);
+    RS_RUN(test_custom_brush_product);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
     return rs_test_finish();

@@ -150,6 +150,12 @@ bool rs_finish_parse(const char *name, rs_finish *out)
     return false;
 }
 
+void rs_cosmetic_set_rgb(rs_cosmetic *c, const uint8_t rgb[3])
+{
+    memcpy(c->rgb, rgb, 3);
+    if (c->colour_weight < 0.5f) c->colour_weight = 0.8f;
+}
+
 void rs_cosmetic_set_finish(rs_cosmetic *c, rs_finish f)
 {
     if ((unsigned)f >= RS_FINISH_COUNT) return;

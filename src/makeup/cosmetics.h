@@ -81,6 +81,8 @@ const char *rs_finish_name(rs_finish f);                    // "matte", "satin",
 bool rs_finish_parse(const char *name, rs_finish *out);
 void rs_cosmetic_set_finish(rs_cosmetic *c, rs_finish f);  // keeps colour, weights, brush
 rs_finish rs_cosmetic_finish(const rs_cosmetic *c);         // the family nearest to c's finish
+// A new colour; a colourless product (gloss, clear powder: colour weight < 0.5) gains one (0.8).
+void rs_cosmetic_set_rgb(rs_cosmetic *c, const uint8_t rgb[3]);
 
 uint32_t rs_cosmetic_count(void);
 // Preset i (0 <= i < rs_cosmetic_count()), in UI order; NULL when out of range.
