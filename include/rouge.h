@@ -2,15 +2,17 @@
 // scattering + measured specular) and touch makeup painting on it, in your own OpenGL ES 3 context.
 //
 // DOES:
-//   - load a face (.rsf, from a file or memory) into a rouge_face that owns the splat cloud, the renderer,
-//     the makeup layer and the painting session;
+//   - load a face (.rsf, from a file, memory, or a rouge_stream still arriving: a preview of its coarse LOD
+//     levels first) into a rouge_face that owns the splat cloud, the renderer, the makeup layer and the
+//     painting session;
 //   - render it into your current GLES 3.0 context: into the framebuffer you have bound (rouge_face_draw),
 //     or into an RGBA8 texture it owns (rouge_face_render + rouge_face_texture); every GL state it
 //     touches (framebuffers, viewport, program, VAO, buffers, textures, blend/depth/scissor/stencil/cull,
 //     masks, pixel-store alignment) is restored before it returns;
 //   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
 //     through an ID buffer, one- and two-finger navigation; brush, eraser, mirror, undo / redo / clear;
-//   - save and load looks (the makeup) as files or memory; record and replay stroke files;
+//   - save and load looks (the makeup) as files or memory, show a second look beside the painted one;
+//     custom products (colour, finish, coverage) on the brush; record and replay stroke files;
 //   - report capabilities of a context you made (rouge_query_caps), picks and statistics.
 // DOES NOT:
 //   - create windows or contexts, or read input devices (your app, GLFW, SDL, Android... does; see

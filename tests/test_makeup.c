@@ -875,6 +875,59 @@ static void test_region_mask_is_zero_outside_and_rises_softly_inside(void)
     rs_splat_destroy(c);
 }
 
+// The lips' mask follows the lip colour and a smooth line, never leaving the region: on a plane whose
+// left half is the lips region, with skin-coloured splats along its border (the region reaching onto the
+// skin above a lip) and a thin red spike of lips label poking into the right half (the region's ragged
+// edge), only the red part deep inside gets the brush; the skin-coloured band, the spike and everything
+// outside get nothing, and the weight never rises towards the border.
+static void test_lips_mask_follows_the_lip_colour_not_the_ragged_region(void)
+{
+    enum { K = 201 };
+    rs_splat *s = rs_alloc_array((size_t)K * K, sizeof *s);
+    REQUIRE(s);
+    float side = 0.4f, step = side / (K - 1), band = 0.03f;  // 5.7 mm of skin colour inside the border
+    for (uint32_t y = 0; y < K; y++)
+        for (uint32_t x = 0; x < K; x++) {
+            float px = -0.5f * side + step * x, py = -0.5f * side + step * y;
+            bool spike = px > -1e-6f && px < 0.012f && fabsf(py) < 0.003f;  // 4.6 mm long, 1.1 mm wide
+            bool lips = px < -1e-6f || spike;
+            bool red = px < -band - 1e-6f || spike;
+            s[y * K + x] = (rs_splat){{px, py, 0}, {0, 0, 1}, step, {0, 0, 0}, lips ? RS_REGION_LIPS : RS_REGION_OTHER};
+            const uint8_t *rgb = red ? (const uint8_t[3]){178, 84, 92} : (const uint8_t[3]){196, 150, 128};
+            memcpy(s[y * K + x].rgb, rgb, 3);
+        }
+    rs_splat_cloud *c = make_cloud(s, K * K, frame(1.0f));
+    free(s);
+    REQUIRE(c);
+    rs_makeup *mk = layer(c, NULL);
+    REQUIRE(mk);
+    const uint8_t *w = NULL;
+    rs_error err = {0};
+    REQUIRE(rs_makeup_region_weights(mk, RS_COSMETIC_REGION_LIPS, &w, &err) == RS_OK && w);
+    float r = RS_MAKEUP_LIP_SMOOTH_MM / c->hdr.mm_per_unit;
+    int outside = 0, spike = 0, skin = 0, deep = 0;
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        float x = c->pos[i][0], y = c->pos[i][1];
+        bool in_spike = x > -1e-6f && x < 0.012f && fabsf(y) < 0.003f;
+        if (in_spike) spike = RS_MAX(spike, (int)w[i]);
+        else if (x > -1e-6f) outside += w[i] != 0;
+        else if (x > -band + r) skin = RS_MAX(skin, (int)w[i]);  // skin colour farther than r from the red
+        else if (x < -band - r && x > -0.5f * side + r) deep += w[i] != 255;
+    }
+    RS_CHECK(outside == 0, "%d splats outside the lips region carry weight", outside);
+    RS_CHECK(spike <= 8, "the thin spike of the region gets weight %d", spike);
+    RS_CHECK(skin == 0, "skin-coloured splats of the region get weight %d", skin);
+    RS_CHECK(deep == 0, "%d splats deep in the red lips are not fully in", deep);
+    uint32_t row = 50 * K;  // y = -0.1: far from the spike
+    int last = 256;
+    for (uint32_t x = 10; x < 100; x++) {
+        RS_CHECK(w[row + x] <= last, "weight rises again towards the border at column %u", x);
+        last = w[row + x];
+    }
+    rs_makeup_destroy(mk);
+    rs_splat_destroy(c);
+}
+
 static void test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_masked(void)
 {
     rs_splat_cloud *c = split_plane();
@@ -937,6 +990,7 @@ int main(int argc, char **argv)
     RS_RUN(test_take_dirty_gives_compact_ranges_per_lod_band);
     RS_RUN(test_overlapping_passes_build_up_without_banding);
     RS_RUN(test_region_mask_is_zero_outside_and_rises_softly_inside);
+    RS_RUN(test_lips_mask_follows_the_lip_colour_not_the_ragged_region);
     RS_RUN(test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_masked);
     return rs_test_finish();
 }

@@ -39,6 +39,7 @@
 //   Then eq. (2) mixes it in. The detail ratio rides in the record's flags byte (q/128), computed once
 //   per cloud here, so the shader needs no neighbourhood.
 #include "makeup/makeup.h"
+#include "core/image.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -527,6 +528,107 @@ static float dist2(const float a[3], const float b[3])
     return x * x + y * y + z * z;
 }
 
+// The lips' mask. The converter's lips region is a blob around the mouth (an ellipse in the face frame,
+// ragged at splat scale: spikes of 1-2 mm): it reaches over the upper lip's border onto the skin, and a
+// mask that fades in from its border keeps the spikes. Two things make the mask follow the lip line:
+// - colour: the vermilion is redder than the skin around it (CIELAB a*), so within the region the splats
+//   split into two colour classes (Otsu's threshold on a*) and each gets a lip likelihood; a face whose
+//   region shows no clear colour step (painted lips, a colourless scan: class means < 4 a* apart) takes
+//   the whole region as lips;
+// - smoothing: the likelihood (0 outside the region) averaged with a Gaussian over
+//   RS_MAKEUP_LIP_SMOOTH_MM, ramped from 0 at half to 1 at 95 %: the lip line is a smooth curve, a spike
+//   thinner than the radius never reaches half, and splats outside the region stay at 0.
+// `w` holds 255 / 0 by region on entry.
+static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
+{
+    enum { BINS = 256 };
+    const float lo = -32.0f, hi = 96.0f, per_bin = (float)BINS / (hi - lo);
+    float *a = rs_alloc_array(RS_MAX(mk->n, 1u), sizeof *a);
+    float *p = rs_alloc_array(RS_MAX(mk->n, 1u), sizeof *p);
+    if (!a || !p) {
+        free(a), free(p);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: lips mask: out of memory");
+    }
+    double hist[BINS] = {0}, total = 0;
+    for (uint32_t i = 0; i < mk->n; i++) {
+        p[i] = w[i] ? 1.0f : 0.0f;
+        if (!w[i]) continue;
+        uint32_t c = mk->cloud->packed[i].w[3];
+        uint8_t rgb[3] = {(uint8_t)c, (uint8_t)(c >> 8), (uint8_t)(c >> 16)};
+        double lab[3];
+        rs_srgb8_to_lab(rgb, lab);
+        a[i] = (float)lab[1];
+        hist[RS_CLAMP((int)((a[i] - lo) * per_bin), 0, BINS - 1)] += 1, total += 1;
+    }
+    // Otsu: the threshold that maximises the between-class variance.
+    double sum_all = 0, w0 = 0, sum0 = 0, best = -1, m0 = 0, m1 = 0;
+    for (int b = 0; b < BINS; b++) sum_all += b * hist[b];
+    int cut = -1;
+    for (int b = 0; b < BINS - 1; b++) {
+        w0 += hist[b], sum0 += b * hist[b];
+        double w1 = total - w0;
+        if (w0 < 1 || w1 < 1) continue;
+        double u0 = sum0 / w0, u1 = (sum_all - sum0) / w1, v = w0 * w1 * (u1 - u0) * (u1 - u0);
+        if (v > best) best = v, cut = b, m0 = u0, m1 = u1;
+    }
+    if (total >= 64 && cut >= 0 && (m1 - m0) / per_bin >= 4.0) {
+        float t = lo + (float)((m0 + 0.3 * (m1 - m0)) / per_bin), band = (float)((m1 - m0) / per_bin) * 0.2f;
+        for (uint32_t i = 0; i < mk->n; i++) {
+            if (!w[i]) continue;
+            float x = RS_CLAMP((a[i] - (t - band)) / (2.0f * band), 0.0f, 1.0f);
+            p[i] = x * x * (3.0f - 2.0f * x);
+        }
+    }
+    const rs_splat_header *h = &mk->cloud->hdr;
+    float r = RS_MAKEUP_LIP_SMOOTH_MM / (h->mm_per_unit > 0.0f ? h->mm_per_unit : 1.0f), r2 = r * r;
+    int reach = RS_CLAMP((int)ceilf(r * mk->inv_cell), 1, 4);
+    for (uint32_t c = 0; c < mk->cell_count; c++) {
+        const grid_cell *gc = &mk->cells[c];
+        bool any = false;
+        for (uint32_t k = gc->start; k < gc->start + gc->count && !any; k++) any = w[mk->order[k]] != 0;
+        if (!any) continue;
+        int cx = (int)(gc->key & 1023u), cy = (int)(gc->key >> 10 & 1023u), cz = (int)(gc->key >> 20 & 1023u);
+        const grid_cell *near[9 * 9 * 9];
+        int nn = 0;
+        for (int dz = -reach; dz <= reach; dz++)
+            for (int dy = -reach; dy <= reach; dy++)
+                for (int dx = -reach; dx <= reach; dx++) {
+                    int x = cx + dx, y = cy + dy, z = cz + dz;
+                    if (x < 0 || y < 0 || z < 0 || (uint32_t)x >= mk->dim[0] || (uint32_t)y >= mk->dim[1] ||
+                        (uint32_t)z >= mk->dim[2])
+                        continue;
+                    const grid_cell *nc = find_cell(mk, cell_key((uint32_t)x, (uint32_t)y, (uint32_t)z));
+                    if (nc) near[nn++] = nc;
+                }
+        for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
+            uint32_t i = mk->order[k];
+            if (!w[i]) continue;
+            const float *pi = mk->cloud->pos[i];
+            const float *ni = mk->cloud->normal[i];
+            double sw = 0, sp = 0;
+            for (int q = 0; q < nn; q++)
+                for (uint32_t m = near[q]->start; m < near[q]->start + near[q]->count; m++) {
+                    uint32_t j = mk->order[m];
+                    float d2 = dist2(mk->cloud->pos[j], pi);
+                    if (d2 >= r2) continue;
+                    // The same sheet of surface only: not the other lip across the closed mouth.
+                    const float *nj = mk->cloud->normal[j];
+                    if (ni[0] * nj[0] + ni[1] * nj[1] + ni[2] * nj[2] < 0.0f) continue;
+                    double g = exp(-4.5 * d2 / r2);  // sigma r / 3
+                    sw += g, sp += g * p[j];
+                }
+            float lip = sw > 0 ? (float)(sp / sw) : p[i];
+            float x = RS_CLAMP((lip - 0.5f) / 0.45f, 0.0f, 1.0f);
+            a[i] = x * x * (3.0f - 2.0f * x);  // a[] (the colours) is free now; applied after the pass
+        }
+    }
+    for (uint32_t i = 0; i < mk->n; i++)
+        if (w[i]) w[i] = (uint8_t)lrintf(255.0f * a[i]);
+    free(a);
+    free(p);
+    return RS_OK;
+}
+
 rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err)
 {
     *out = NULL;
@@ -565,6 +667,18 @@ rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, con
     if (inside == 0) {  // nothing of this face is in the mask: ignore it rather than paint nothing
         free(w);
         free(cell_out);
+        return RS_OK;
+    }
+    if (region == RS_COSMETIC_REGION_LIPS) {
+        free(cell_out);
+        rs_result r = lips_mask(mk, w, err);
+        if (r) {
+            free(w);
+            mk->mask_built[region] = false;
+            return r;
+        }
+        mk->mask[region] = w;
+        *out = w;
         return RS_OK;
     }
     // Soft edge: each splat inside takes smoothstep(b / edge), b its distance to the region's border. The

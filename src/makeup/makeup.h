@@ -66,6 +66,7 @@ typedef enum rs_makeup_pressure {
 #define RS_MAKEUP_TOUCH_K 1.0f      // I_F = 1 - exp(-touches / K), touches = strokes that reached the splat
 #define RS_MAKEUP_SIGMA_REL 0.5f    // I_G Gaussian sigma = 0.5 * brush radius (shifted to reach 0 at the rim)
 #define RS_MAKEUP_MASK_EDGE_MM 1.5f // region masks fade in over this distance inside the region's border
+#define RS_MAKEUP_LIP_SMOOTH_MM 3.0f // the lips mask: lip colour averaged over this radius (makeup.c)
 
 typedef struct rs_makeup_desc {
     uint32_t undo_levels;  // strokes kept for undo/redo; 0 = 64
