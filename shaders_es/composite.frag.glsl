@@ -46,6 +46,7 @@ uniform float u_key_widen;      // the key light's angular radius / 2: added in 
 uniform int u_tonemap;          // 0: filmic, 1: clamp (the paper's figures)
 uniform mat4 u_inv_view;        // view -> model (flakes are fixed on the surface)
 uniform float u_flake_size;     // model units
+uniform float u_contour_reach;  // view units (20 mm): a surface this close behind a contour hides its rim
 
 out vec4 o_color;
 
@@ -131,6 +132,33 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
 // a stair step at 3/8, an inner corner at 7/8, a stray pixel outside the edge gone. The mask is binary and
 // stable from frame to frame, so the edge is smooth without the speckle the splats' own (noisy) weights
 // give; pixels with no background near are untouched.
+// How much of the sky a pixel seen edge-on still reflects. At a contour in front of more face (the
+// nostril rim over the upper lip, an ear over the neck) the grazing mirror direction runs into that
+// surface close behind, not into the environment; the environment's grazing Fresnel reflection then drew
+// a bright 1-px outline along such contours. The surface behind is looked for across the contour, a few
+// pixels along the screen projection of the normal: one that lies behind this point and faces the eye
+// (the same surface curving away stays edge-on there: a cheek's grazing sheen is kept), within
+// u_contour_reach, occludes the rim (fully up to half the reach); background or a far surface leaves it
+// open (a real rim light).
+float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
+{
+    if (edge_on <= 0.0 || dot(N.xy, N.xy) < 1e-6) return 1.0;
+    vec2 d = normalize(N.xy);
+    ivec2 hi = ivec2(u_viewport) - 1;
+    float gap = 1e9;
+    for (int k = 1; k <= 4; k++) {
+        vec2 f = gl_FragCoord.xy + d * float(k);
+        vec3 q;
+        if (!rs_visible_point_at(rs_depth_pixel(f), q)) continue;
+        vec4 a = texelFetch(u_attr0, clamp(ivec2(f), ivec2(0), hi), 0);
+        if (a.a <= u_min_weight) continue;
+        vec3 nq = normalize(texelFetch(u_attr1, clamp(ivec2(f), ivec2(0), hi), 0).xyz / a.a * 2.0 - 1.0);
+        float behind = p.z - q.z;
+        if (behind > 0.05 * u_contour_reach && dot(nq, normalize(-q)) > ndotv + 0.25) gap = min(gap, behind);
+    }
+    return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
+}
+
 bool uncovered(ivec2 q)
 {
     return texelFetch(u_attr0, clamp(q, ivec2(0), ivec2(u_viewport) - 1), 0).a <= u_min_weight;
@@ -203,10 +231,13 @@ void main()
             C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
                                * shadow);
         if (u_env_on > 0.5) {
-            // Sky occlusion stands in for the specular's visibility too (eye sockets, nostrils).
+            // Sky occlusion stands in for the specular's visibility too (eye sockets, nostrils), and at
+            // contours the surface just behind them.
+            float ndotv = dot(N, V);
+            float so = ao * contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv));
             E += rs_env_irradiance(N) * ao;
-            S += rs_env_specular(N, V, m, RS_F0_SKIN) * (rho_s * ao);
-            if (coat > 0.0) C += rs_env_specular(N, V, mc, RS_F0_COAT) * ao;
+            S += rs_env_specular(N, V, m, RS_F0_SKIN) * (rho_s * so);
+            if (coat > 0.0) C += rs_env_specular(N, V, mc, RS_F0_COAT) * so;
         }
         C *= coat;
         // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).
@@ -228,6 +259,14 @@ void main()
             Ed = le > 1e-6 ? E * (lc / le) : vec3(lc);
         }
         vec3 Dd = D.rgb * u_diffuse_scale + u_delta_weight * Ed;
+        // Across a fold (the alar groove, a lid crease) the drawn levels' widest, reddest Gaussians gather
+        // light from the lit side of the groove; seen edge-on, that bleed reads as a thin red line. There
+        // D's red is held within 1.25 x its green, relative to the light's own colour (Ed: a sunset's
+        // orange stays orange).
+        if (edge_on > 0.0) {
+            float k = 1.25 * (Ed.r + 1e-4) / (Ed.g + 1e-4);
+            Dd.r = mix(Dd.r, min(Dd.r, k * Dd.g), edge_on);
+        }
         if (u_mode == MODE_DIFFUSE) c = A * Dd;
         else if (u_mode == MODE_SPECULAR) c = S + C;
         else if (u_mode == MODE_IRRADIANCE) c = E;

@@ -31,6 +31,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniformMatrix4fv(rs_uloc(prog, "u_inv_view"), 1, GL_FALSE, (const float *)cam->inv_view);
     // Flakes of ~0.3 mm: a few pixels each in a close-up, about one per pixel in a full-face view.
     glUniform1f(rs_uloc(prog, "u_flake_size"), 0.3f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
+    glUniform1f(rs_uloc(prog, "u_contour_reach"), 20.0f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
     rs_render_env_uniforms(r, f, prog);
     // Under an environment the highlight is what skin's surface reflects, white (a dielectric); the
     // paper's A (D + S) tints it with the albedo, which the paper's figures keep.
