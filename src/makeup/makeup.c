@@ -374,6 +374,29 @@ static const grid_cell *find_cell(const rs_makeup *mk, uint32_t key)
     }
 }
 
+static void cell_coords(const grid_cell *gc, int xyz[3])
+{
+    xyz[0] = (int)(gc->key & 1023u), xyz[1] = (int)(gc->key >> 10 & 1023u), xyz[2] = (int)(gc->key >> 20 & 1023u);
+}
+
+// The occupied cells within `reach` (<= 4) cells of gc along each axis, gc included, into near[9 * 9 * 9].
+static int cells_near_cell(const rs_makeup *mk, const grid_cell *gc, int reach, const grid_cell **near)
+{
+    int c[3], n = 0;
+    cell_coords(gc, c);
+    for (int dz = -reach; dz <= reach; dz++)
+        for (int dy = -reach; dy <= reach; dy++)
+            for (int dx = -reach; dx <= reach; dx++) {
+                int x = c[0] + dx, y = c[1] + dy, z = c[2] + dz;
+                if (x < 0 || y < 0 || z < 0 || (uint32_t)x >= mk->dim[0] || (uint32_t)y >= mk->dim[1] ||
+                    (uint32_t)z >= mk->dim[2])
+                    continue;
+                const grid_cell *nc = find_cell(mk, cell_key((uint32_t)x, (uint32_t)y, (uint32_t)z));
+                if (nc) near[n++] = nc;
+            }
+    return n;
+}
+
 static uint32_t axis_cell(const rs_makeup *mk, int a, float v)
 {
     float f = (v - mk->origin[a]) * mk->inv_cell;
@@ -587,19 +610,8 @@ static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
         bool any = false;
         for (uint32_t k = gc->start; k < gc->start + gc->count && !any; k++) any = w[mk->order[k]] != 0;
         if (!any) continue;
-        int cx = (int)(gc->key & 1023u), cy = (int)(gc->key >> 10 & 1023u), cz = (int)(gc->key >> 20 & 1023u);
         const grid_cell *near[9 * 9 * 9];
-        int nn = 0;
-        for (int dz = -reach; dz <= reach; dz++)
-            for (int dy = -reach; dy <= reach; dy++)
-                for (int dx = -reach; dx <= reach; dx++) {
-                    int x = cx + dx, y = cy + dy, z = cz + dz;
-                    if (x < 0 || y < 0 || z < 0 || (uint32_t)x >= mk->dim[0] || (uint32_t)y >= mk->dim[1] ||
-                        (uint32_t)z >= mk->dim[2])
-                        continue;
-                    const grid_cell *nc = find_cell(mk, cell_key((uint32_t)x, (uint32_t)y, (uint32_t)z));
-                    if (nc) near[nn++] = nc;
-                }
+        int nn = cells_near_cell(mk, gc, reach, near);
         for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
             uint32_t i = mk->order[k];
             if (!w[i]) continue;
@@ -694,23 +706,17 @@ rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, con
     int reach = RS_CLAMP((int)ceilf(reach_d * mk->inv_cell), 1, 4);
     for (uint32_t c = 0; c < mk->cell_count; c++) {
         const grid_cell *gc = &mk->cells[c];
-        int cx = (int)(gc->key & 1023u), cy = (int)(gc->key >> 10 & 1023u), cz = (int)(gc->key >> 20 & 1023u);
         // The neighbour cells holding splats outside, found once per cell (most cells have none), and the
         // adjacent ones (for the spacing).
-        const grid_cell *near[9 * 9 * 9], *adj[27];
-        int nn = 0, na = 0;
-        for (int dz = -reach; dz <= reach; dz++)
-            for (int dy = -reach; dy <= reach; dy++)
-                for (int dx = -reach; dx <= reach; dx++) {
-                    int x = cx + dx, y = cy + dy, z = cz + dz;
-                    if (x < 0 || y < 0 || z < 0 || (uint32_t)x >= mk->dim[0] || (uint32_t)y >= mk->dim[1] ||
-                        (uint32_t)z >= mk->dim[2])
-                        continue;
-                    const grid_cell *nc = find_cell(mk, cell_key((uint32_t)x, (uint32_t)y, (uint32_t)z));
-                    if (!nc) continue;
-                    if (cell_out[nc - mk->cells]) near[nn++] = nc;
-                    if (abs(dx) <= 1 && abs(dy) <= 1 && abs(dz) <= 1) adj[na++] = nc;
-                }
+        const grid_cell *all[9 * 9 * 9], *near[9 * 9 * 9], *adj[27];
+        int na_all = cells_near_cell(mk, gc, reach, all), nn = 0, na = 0, c0[3];
+        cell_coords(gc, c0);
+        for (int q = 0; q < na_all; q++) {
+            int c1[3];
+            cell_coords(all[q], c1);
+            if (cell_out[all[q] - mk->cells]) near[nn++] = all[q];
+            if (abs(c1[0] - c0[0]) <= 1 && abs(c1[1] - c0[1]) <= 1 && abs(c1[2] - c0[2]) <= 1) adj[na++] = all[q];
+        }
         for (uint32_t k = gc->start; nn && k < gc->start + gc->count; k++) {
             uint32_t i = mk->order[k];
             if (!w[i]) continue;
