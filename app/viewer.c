@@ -326,29 +326,23 @@ static void mark_input(vw_viewer *v)
 #define VW_PREVIEW_EVERY_S 0.5  // a slow stream refines at most this often (each face opened costs a renderer)
 #define VW_PREVIEW_AFTER_S 0.1  // a local 600k face loads in ~40 ms: no preview for it
 
-// Reads the file (or standard input for "-") into the stream; the frame loop makes preview faces from
-// it as LOD levels complete. Standard input is polled so that quitting cancels a stalled stream.
+// Reads the open file (or standard input) into the stream; the frame loop makes preview faces from it
+// as LOD levels complete. Standard input is polled so that quitting cancels a stalled stream.
 static void *load_main(void *arg)
 {
     vw_loader *l = arg;
-    bool in = !strcmp(l->path, "-");
-    int fd = in ? 0 : open(l->path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    uint8_t *buf = NULL;
+    uint8_t *buf = malloc(VW_READ_BYTES);
     rouge_result r = ROUGE_OK;
-    struct stat st;
-    rs_error e = {0};
-    if (fd < 0) rs_fail(&e, RS_ERR_IO, "%s: cannot open: %s", l->path, strerror(errno));
-    else if (!in && fstat(fd, &st) != 0) rs_fail(&e, RS_ERR_IO, "%s: cannot stat: %s", l->path, strerror(errno));
-    // Regular files only (or an explicit "-"): a directory, /dev/zero or a FIFO would hang or never end.
-    else if (!in && !S_ISREG(st.st_mode)) rs_fail(&e, RS_ERR_IO, "%s: not a regular file", l->path);
-    else if (!(buf = malloc(VW_READ_BYTES))) rs_fail(&e, RS_ERR_NOMEM, "%s: out of memory", l->path);
-    if (e.code) r = (rouge_result)e.code, l->err.code = r, memcpy(l->err.msg, e.msg, sizeof l->err.msg);
+    if (!buf) {
+        l->err.code = r = ROUGE_ERR_NOMEM;
+        snprintf(l->err.msg, sizeof l->err.msg, "%s: out of memory", l->path);
+    }
     while (!r && !atomic_load(&l->cancel) && !rouge_stream_get_progress(l->stream).complete) {
-        if (in) {
-            struct pollfd pfd = {.fd = fd, .events = POLLIN};
+        if (l->fd == 0) {
+            struct pollfd pfd = {.fd = 0, .events = POLLIN};
             if (poll(&pfd, 1, 100) == 0) continue;
         }
-        ssize_t n = read(fd, buf, VW_READ_BYTES);
+        ssize_t n = read(l->fd, buf, VW_READ_BYTES);
         if (n < 0 && (errno == EINTR || errno == EAGAIN)) continue;
         if (n < 0) {
             l->err.code = r = ROUGE_ERR_IO;
@@ -363,7 +357,7 @@ static void *load_main(void *arg)
                  atomic_load(&l->cancel) ? "loading cancelled" : "the file ends early (truncated)");
     }
     free(buf);
-    if (fd > 0) close(fd);
+    if (l->fd > 0) close(l->fd);
     l->result = r;
     atomic_store(&l->done, true);
     return NULL;
@@ -380,14 +374,22 @@ static rs_result load_start(vw_viewer *v, const char *path, rs_error *err)
     atomic_store(&l->cancel, false);
     bool in = !strcmp(path, "-");
     struct stat st;
-    uint64_t size = !in && stat(path, &st) == 0 && S_ISREG(st.st_mode) ? (uint64_t)st.st_size : 0;
+    l->fd = in ? 0 : open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (l->fd < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    rs_result r = RS_OK;
+    if (!in && fstat(l->fd, &st) != 0) r = rs_fail(err, RS_ERR_IO, "%s: cannot stat: %s", path, strerror(errno));
+    // Regular files only (or an explicit "-"): a directory, /dev/zero or a FIFO would hang or never end.
+    else if (!in && !S_ISREG(st.st_mode)) r = rs_fail(err, RS_ERR_IO, "%s: not a regular file", path);
     rouge_error e = {0};
-    if (rouge_stream_create(in ? "(standard input)" : path, size, &l->stream, &e) != ROUGE_OK)
-        return rs_fail(err, (rs_result)e.code, "%s", e.msg);
-    if (pthread_create(&l->thread, NULL, load_main, l) != 0) {
+    if (!r && rouge_stream_create(in ? "(standard input)" : path, in ? 0 : (uint64_t)st.st_size, &l->stream, &e))
+        r = rs_app_error((rouge_result)e.code, &e, err);
+    if (!r && pthread_create(&l->thread, NULL, load_main, l) != 0)
+        r = rs_fail(err, RS_ERR_NOMEM, "cannot start a loader thread");
+    if (r) {
         rouge_stream_destroy(l->stream);
         l->stream = NULL;
-        return rs_fail(err, RS_ERR_NOMEM, "cannot start a loader thread");
+        if (l->fd > 0) close(l->fd);
+        return r;
     }
     l->running = true;
     return RS_OK;
@@ -458,7 +460,7 @@ static rs_result face_open(vw_viewer *v, rs_error *err)
     if (!r && v->cli->record) r = rouge_face_record_strokes(f, v->cli->record, &e);
     if (r) {
         rouge_face_destroy(f);
-        return rs_fail(err, (rs_result)r, "%s", e.msg);
+        return rs_app_error(r, &e, err);
     }
     face_close(v);
     vw_looks_forget_face(v);
@@ -477,9 +479,8 @@ rs_result vw_load_look_file(vw_viewer *v, const char *path, rs_error *err)
     rouge_error e = {0};
     rouge_result r = rouge_face_load_look(v->face, path, &e);
     if (r != ROUGE_OK) {
-        rs_fail(err, (rs_result)r, "%s", e.msg);
-        vw_toast(v, true, "%s", err->msg);
-        return (rs_result)r;
+        vw_toast(v, true, "%s", e.msg);
+        return rs_app_error(r, &e, err);
     }
     v->dirty_makeup = true;
     return RS_OK;
@@ -825,27 +826,26 @@ static rs_result render_scene(vw_viewer *v, rs_error *err)
     if (!v->dirty_view && !v->dirty_makeup && !quality_change) return RS_OK;
     apply_rung(v, want);
     rouge_error e = {0};
-    rouge_result r = ROUGE_OK;
+    rs_result r = RS_OK;
     if (v->split && (v->dirty_view || quality_change || !v->before.tex || v->looks.compare_dirty)) {
         // The left half: the bare face, or a look from the library to compare with.
         v->view.compare_look = true;
         push_view(v);
-        r = rouge_face_render(v->face, &e);
+        r = rs_app_error(rouge_face_render(v->face, &e), &e, err);
         v->view.compare_look = false;
         v->looks.compare_dirty = false;
         int tw, th;
         GLuint tex = rouge_face_texture(v->face, &tw, &th);
-        rs_error e2 = {0};
-        if (!r && rs_ui_texture_copy(&v->before, tex, tw, th, &e2)) r = (rouge_result)e2.code, e = (rouge_error){0}, memcpy(e.msg, e2.msg, sizeof e.msg);
+        if (!r) r = rs_ui_texture_copy(&v->before, tex, tw, th, err);
     }
     push_view(v);
-    if (!r) r = rouge_face_render(v->face, &e);
+    if (!r) r = rs_app_error(rouge_face_render(v->face, &e), &e, err);
     v->info = rouge_face_stats(v->face);
     v->dirty_view = v->dirty_makeup = false;
     v->rendered = want;
     v->rendered_full = !inter;
     v->rendered_this_frame = true;
-    return r ? rs_fail(err, (rs_result)r, "%s", e.msg) : RS_OK;
+    return r;
 }
 
 // What a toolbar tap or drag does (the same actions as the keys).
@@ -1112,7 +1112,8 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
     if (v->face && cli->record) {
         // Every stroke in the recording's file before the viewer says it is done.
         rouge_error e2 = {0};
-        if (rouge_face_flush_strokes(v->face, &e2) != ROUGE_OK && !r) r = rs_fail(err, (rs_result)e2.code, "%s", e2.msg);
+        rouge_result fr = rouge_face_flush_strokes(v->face, &e2);
+        if (!r) r = rs_app_error(fr, &e2, err);
     }
     load_abort(v);
     vw_looks_free(v);

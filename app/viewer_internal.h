@@ -154,6 +154,7 @@ typedef struct vw_loader {
     bool initial;                 // the face named on the command line: failing to load it is fatal
     atomic_bool done, cancel;
     char path[512];
+    int fd;                       // the open file (0: standard input), closed by the reading thread
     rouge_stream *stream;
     rouge_result result;          // the reading thread's, once done
     rouge_error err;

@@ -150,15 +150,15 @@ static rs_result render_thumbnail(vw_viewer *v, rs_image *out, rs_error *err)
     tv.env = v->env_name;
     rouge_error e = {0};
     rs_image img = {0};
-    rouge_result r = rouge_face_set_view(v->face, &tv, &e);
-    if (!r) r = rouge_face_render(v->face, &e);
-    if (!r && rs_image_create(tv.width, tv.height, 4, &img, err) != RS_OK) r = (rouge_result)err->code, snprintf(e.msg, sizeof e.msg, "%s", err->msg);
-    if (!r) r = rouge_face_read_rgba(v->face, img.pixels, (size_t)img.width * img.height * 4, &e);
+    rs_result r = rs_app_error(rouge_face_set_view(v->face, &tv, &e), &e, err);
+    if (!r) r = rs_app_error(rouge_face_render(v->face, &e), &e, err);
+    if (!r) r = rs_image_create(tv.width, tv.height, 4, &img, err);
+    if (!r) r = rs_app_error(rouge_face_read_rgba(v->face, img.pixels, (size_t)img.width * img.height * 4, &e), &e, err);
     v->dirty_view = true;
     v->looks.compare_dirty = true;
     if (r) {
         rs_image_free(&img);
-        return rs_fail(err, (rs_result)r, "%s", e.msg);
+        return r;
     }
     uint8_t *d = img.pixels;
     for (size_t i = 0; i < (size_t)img.width * img.height; i++, d += 3) memmove(d, img.pixels + i * 4, 3);
@@ -183,8 +183,7 @@ static void save(vw_viewer *v, bool overwrite)
     size_t len = 0;
     rs_image thumb = {0};
     rouge_error e = {0};
-    rs_result r = RS_OK;
-    if (rouge_face_save_look_memory(v->face, &text, &len, &e) != ROUGE_OK) r = rs_fail(&err, (rs_result)e.code, "%s", e.msg);
+    rs_result r = rs_app_error(rouge_face_save_look_memory(v->face, &text, &len, &e), &e, &err);
     if (!r) r = render_thumbnail(v, &thumb, &err);
     if (!r) r = rs_looklib_save(L->dir, L->name, text, len, &thumb, overwrite, &err);
     rouge_free(text);
@@ -226,7 +225,7 @@ static void compare(vw_viewer *v, int i)
         char path[1100];
         rs_result r = rs_looklib_path(L->dir, L->entries[i].name, false, path, sizeof path, &err);
         rouge_error e = {0};
-        if (!r && rouge_face_set_compare_look(v->face, path, &e) != ROUGE_OK) r = rs_fail(&err, (rs_result)e.code, "%s", e.msg);
+        if (!r) r = rs_app_error(rouge_face_set_compare_look(v->face, path, &e), &e, &err);
         if (r) {
             vw_toast(v, true, "%s", err.msg);
             return;

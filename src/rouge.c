@@ -864,7 +864,8 @@ rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge
     if (!(b.size >= 0 && b.size <= 2) || !(b.opacity >= 0 && b.opacity <= 1))
         return fail_arg(err, "brush: size must be 0..2 (face heights), opacity 0..1");
     if ((unsigned)b.finish > ROUGE_FINISH_SHIMMER) return fail_arg(err, "brush: unknown finish");
-    if (!(b.coverage <= 1) || !(b.color[3] >= 0)) return fail_arg(err, "brush: coverage must be <= 1, colour alpha >= 0");
+    if (!(b.coverage <= 1) || !(b.color[3] >= 0) || !isfinite(b.color[0] + b.color[1] + b.color[2]))
+        return fail_arg(err, "brush: coverage must be <= 1, the colour finite with alpha >= 0");
     rs_paint_brush pb = {.cosmetic = *c, .size_rel = b.size, .opacity = b.opacity,
                          .pressure = (rs_makeup_pressure)b.pressure, .eraser = b.eraser, .mirror = b.mirror,
                          .any_region = b.any_region};

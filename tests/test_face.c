@@ -499,6 +499,8 @@ static void test_custom_brush_product(void)
     rouge_free(look);
     RS_CHECK(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .finish = (rouge_finish)9}, &e) == ROUGE_ERR_ARG,
              "unknown finish: %s", e.msg);
+    RS_CHECK(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .color = {NAN, 0, 0, 1}}, &e) == ROUGE_ERR_ARG,
+             "a NaN colour: %s", e.msg);
     rouge_cosmetic c;
     bool found = false;
     for (int i = 0; rouge_cosmetic_get(i, &c); i++)
