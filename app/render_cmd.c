@@ -92,13 +92,6 @@ static rouge_result paint(const rs_cli *cli, rouge_face *face, rouge_error *e)
     return r;
 }
 
-// True when `a` and `b` name the same existing file (hard links and ./x vs x included).
-static bool same_file(const char *a, const char *b)
-{
-    struct stat sa, sb;
-    return a && b && stat(a, &sa) == 0 && stat(b, &sb) == 0 && sa.st_dev == sb.st_dev && sa.st_ino == sb.st_ino;
-}
-
 rs_result rs_app_render(const rs_cli *cli, rs_error *err)
 {
     if (!cli->output) return rs_fail(err, RS_ERR_ARG, "render: no output given (-o OUT.png)");
@@ -108,9 +101,9 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
     const char *path = cli->face ? cli->face : rs_app_default_face(def, sizeof def);
     const char *inputs[] = {path, cli->look, cli->strokes};
     for (size_t i = 0; i < RS_COUNT_OF(inputs); i++)
-        if (same_file(cli->output, inputs[i]))
+        if (rs_same_file(cli->output, inputs[i]))
             return rs_fail(err, RS_ERR_ARG, "-o %s is an input of this render; refusing to overwrite it", cli->output);
-    if (same_file(cli->save_look, path) || same_file(cli->save_look, cli->strokes))
+    if (rs_same_file(cli->save_look, path) || rs_same_file(cli->save_look, cli->strokes))
         return rs_fail(err, RS_ERR_ARG, "--save-look %s is an input of this render; refusing to overwrite it",
                        cli->save_look);
     rs_gl_context *gl = NULL;

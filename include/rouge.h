@@ -8,7 +8,9 @@
 //   - render it into your current GLES 3.0 context: into the framebuffer you have bound (rouge_face_draw),
 //     or into an RGBA8 texture it owns (rouge_face_render + rouge_face_texture); every GL state it
 //     touches (framebuffers, viewport, program, VAO, buffers, textures, blend/depth/scissor/stencil/cull,
-//     masks, pixel-store alignment) is restored before it returns;
+//     masks, the whole pack and unpack pixel-store state) is restored before it returns; your scissor,
+//     pixel-store settings and an sRGB framebuffer (it writes so the picture is encoded once) do not
+//     change what it draws or reads;
 //   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
 //     through an ID buffer, one- and two-finger navigation; brush, eraser, mirror, undo / redo / clear;
 //   - save and load looks (the makeup) as files or memory, show a second look beside the painted one;
@@ -22,11 +24,41 @@
 //   - block: except the file functions (they read / write files) and rouge_face_create (parses the face,
 //     compiles shaders), calls return after queueing GL work; rouge_face_read_rgba, rouge_face_write_png
 //     and rouge_face_pick wait for the GPU.
-//   - work on several threads at once: call a face from the thread whose context is current, the same
-//     context (or one sharing its objects) for its whole life.
+//   - work on several threads at once: call a face from the thread whose context is current, the
+//     context it was created in, for its whole life.
 //
 // Structs are options: their zero value means the documented default (so `(rouge_view){0}` is the
-// default view, `(rouge_brush){.cosmetic = "blush"}` a blush with its own size and opacity).
+// default view, `(rouge_brush){.cosmetic = "blush"}` a blush with its own size and opacity). Always
+// zero-initialise the structs you pass (`= {0}` or designated initialisers): a field added later then
+// keeps the behaviour you built against.
+//
+// Rules every function keeps:
+//   - NULL: a NULL face or stream returns ROUGE_ERR_ARG (false, 0 or a zero struct where a function
+//     returns those; void functions do nothing). `err` and the `out` of rouge_face_pointer and
+//     rouge_face_pick may be NULL; so may the pointers a comment says may be. Any other NULL pointer is
+//     ROUGE_ERR_ARG (false for rouge_cosmetic_get), never a crash.
+//   - Outputs (`*out`, `*data`, `*size`, the buffer of read_rgba) are written only on success; on
+//     failure they hold what they held before (one exception: rouge_face_pointer fills `out` for an
+//     event it took even when it returns an earlier stroke file's write failure). A rouge_error is
+//     written only on failure.
+//   - Strings rouge returns (rouge_version, rouge_result_name, rouge_environment_name, the names in a
+//     rouge_cosmetic) are static: valid for the life of the program. Strings you pass are copied or
+//     used during the call only.
+//   - GL: the calls that use GL (create, destroy, set_view with a new environment, draw, render,
+//     read_rgba, write_png, pointer, pick, play_strokes) need the face's own context current: with none
+//     or another one they return ROUGE_ERR_GL (pick: false) and touch nothing; destroy then leaks the
+//     face's GL objects rather than delete another context's. The context is told apart through EGL
+//     (WebGL: emscripten's html5 API); a face made in a context EGL does not know (GLX, WGL) is not checked.
+//   - GL errors you left pending when such a call begins are yours: rouge takes them off the context
+//     (GL cannot put them back) so they are never blamed on a stage of rouge's, and keeps the first for
+//     rouge_face_take_host_gl_error (rouge_face_destroy drops them). Call glGetError before rouge if you
+//     need them all, in order.
+//
+// ABI: this is 0.x. A patch release (0.1.x) changes neither API nor ABI. A minor release (0.2) may
+// change both: struct fields are only ever appended (a new field's zero keeps the old behaviour),
+// enum values only appended, nothing renamed in place; but a grown struct is an ABI change, so rebuild
+// against the new header (the SONAME stays librouge.so.0 until 1.0; compare rouge_version_number() with
+// ROUGE_VERSION_NUMBER to catch a host built against another minor).
 //
 //   rouge_error err;
 //   rouge_face *face;
@@ -54,6 +86,12 @@ extern "C" {
 #define ROUGE_VERSION_MAJOR 0
 #define ROUGE_VERSION_MINOR 1
 #define ROUGE_VERSION_PATCH 0
+// major * 10000 + minor * 100 + patch: 100 for 0.1.0.
+#define ROUGE_VERSION_NUMBER (ROUGE_VERSION_MAJOR * 10000 + ROUGE_VERSION_MINOR * 100 + ROUGE_VERSION_PATCH)
+
+// The library's own version (the one linked, which may differ from the header's macros): "0.1.0".
+const char *rouge_version(void);
+uint32_t rouge_version_number(void);  // the library's ROUGE_VERSION_NUMBER
 
 // --- errors ------------------------------------------------------------------------------------------
 
@@ -133,11 +171,15 @@ typedef struct rouge_light {
     float intensity;    // 0 = 1 (key light); the fill light is on only when intensity > 0
 } rouge_light;
 
+// The largest frame side rouge renders, in pixels (a view's width and height, a draw rectangle's size).
+#define ROUGE_VIEW_MAX_SIZE 8192
+
 typedef struct rouge_view {
-    int width, height;           // render size in pixels; 0 = the draw rectangle's (or 512 x 512)
+    int width, height;           // render size in pixels, 0..ROUGE_VIEW_MAX_SIZE; 0 = the draw rectangle's
+                                 // (or 512 x 512)
     float yaw_deg, pitch_deg;    // camera orbiting the face centre; 0, 0 = frontal
     float zoom;                  // 0 = 1: the face height fills ~80% of the view height; 2 = twice as close
-    float fov_deg;               // vertical field of view; 0 = 30
+    float fov_deg;               // vertical field of view, 1..150; 0 = 30
     float pan[2];                // screen shift, fractions of the view height (+x right, +y down)
     const char *env;             // lighting: "studio" (NULL or "" = this), "daylight", "office", "sunset", a
                                  // path to a .rse file (tools/env), or "paper": the key/fill/ambient below
@@ -181,8 +223,11 @@ typedef struct rouge_face_desc {
     uint32_t undo_levels;        // strokes kept for undo; 0 = 64
     bool manual_navigation;      // pointer gestures only report orbit / pan / zoom, the camera stays
     bool no_float_targets;       // force the RGBA8 fallback (tests; drivers with broken float blending)
-    const char *env_dir;         // where the named environments' .rse files are looked for first; NULL =
-                                 // only assets/env (a source tree) and the installed share/rouge/env
+    const char *env_dir;         // where the named environments' .rse files are looked for first; then
+                                 // beside the library's own file (found at run time): share/rouge/env of
+                                 // the prefix its lib/ (or a static host's bin/) is in, wherever it was
+                                 // installed, or assets/env of the source tree whose build/ holds it;
+                                 // last the PREFIX it was built for. Never the working directory.
 } rouge_face_desc;
 
 // Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
@@ -205,16 +250,18 @@ typedef struct rouge_stream_progress {
 // `name` names the stream in messages (NULL = "(stream)"); total_bytes is the file's size when known
 // (checked against the header before anything is allocated), 0 when not.
 rouge_result rouge_stream_create(const char *name, uint64_t total_bytes, rouge_stream **out, rouge_error *err);
-// The next bytes. Errors (malformed or surplus bytes) are sticky: every later call repeats the first.
+// The next bytes (data may be NULL only when size is 0). Errors (malformed or surplus bytes) are sticky:
+// every later call repeats the first.
 rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, rouge_error *err);
 rouge_stream_progress rouge_stream_get_progress(rouge_stream *s);
 void rouge_stream_destroy(rouge_stream *s);  // NULL is fine; faces made from it keep their splats
-// With the creating context current. NULL is fine.
+// With the creating context current (else its GL objects are leaked, not deleted). NULL is fine.
 void rouge_face_destroy(rouge_face *face);
 
 // The view (copied, also the env string). ROUGE_ERR_ARG for an unknown mode, pipeline or environment,
-// ROUGE_ERR_IO / ROUGE_ERR_FORMAT for an environment file that is missing or corrupt;
-// the previous view stays then.
+// a size over ROUGE_VIEW_MAX_SIZE, kernel_count outside 2..4, any number NaN, infinite or beyond +-1e6
+// (the message names the field: "view.yaw_deg is NaN"); ROUGE_ERR_IO / ROUGE_ERR_FORMAT for an
+// environment file that is missing or corrupt; the previous view stays then. NULL view = the default.
 rouge_result rouge_face_set_view(rouge_face *face, const rouge_view *view, rouge_error *err);
 // The view as set, with the camera as navigation left it.
 rouge_view rouge_face_get_view(const rouge_face *face);
@@ -232,7 +279,9 @@ void rouge_face_zoom_at(rouge_face *face, float factor, float x_px, float y_px);
 
 // Renders the face into the rectangle (x, y, w, h) of the framebuffer bound for drawing (GL pixels,
 // origin bottom-left); w or h 0 = the current viewport. Rendered at the view's size (0 = the rectangle's)
-// and copied (scaled when sizes differ). The target must be single-sampled.
+// and copied (scaled when sizes differ). The target must be single-sampled. Your scissor test does not
+// apply (the rectangle is the only clip); an sRGB target (SRGB8_ALPHA8, an sRGB surface) gets the same
+// picture as an RGBA8 one. The frame it renders is "the last frame" pointer events and picks refer to.
 rouge_result rouge_face_draw(rouge_face *face, int x, int y, int w, int h, rouge_error *err);
 // Renders into the face's own texture only (view size; 0 = 512 x 512).
 rouge_result rouge_face_render(rouge_face *face, rouge_error *err);
@@ -241,10 +290,14 @@ rouge_result rouge_face_render(rouge_face *face, rouge_error *err);
 uint32_t rouge_face_texture(const rouge_face *face, int *width, int *height);
 // The last frame as RGBA8, rows top-first, into rgba (at least width * height * 4 bytes).
 rouge_result rouge_face_read_rgba(rouge_face *face, uint8_t *rgba, size_t capacity, rouge_error *err);
-// The last frame as a PNG (written to a temporary file and renamed: never half-written).
+// The last frame as a PNG (written to a temporary file and renamed: never half-written). ROUGE_ERR_ARG
+// for the .rsf the face was loaded from (same file by device and inode, under any name).
 rouge_result rouge_face_write_png(rouge_face *face, const char *path, rouge_error *err);
 // True when the view or the makeup changed since the last frame (a host that redraws on demand asks).
 bool rouge_face_changed(const rouge_face *face);
+// The first GL error (a GLenum: 0x0502 GL_INVALID_OPERATION, ...) that was pending in your context when a
+// call of this face began, since the last time you asked; 0 when none. Asking clears it.
+uint32_t rouge_face_take_host_gl_error(rouge_face *face);
 
 // --- painting ------------------------------------------------------------------------------------------
 
@@ -258,7 +311,10 @@ typedef enum rouge_pointer_type {
 typedef struct rouge_pointer_event {
     rouge_pointer_type type;
     int id;            // the touch / pointer id; two ids down at once pinch and pan
-    float x, y;        // pixels of the last frame (view size), origin top-left
+    float x, y;        // pixels of the last frame, origin its top-left: the frame of the latest draw or
+                       // render, whichever came last (a draw's frame covers its rectangle: subtract the
+                       // rectangle's top-left and scale by view size / rectangle size when they differ);
+                       // before any frame, the view's size (0 = 512 x 512)
     float pressure;    // 0..1; 0 = 1 (a mouse)
     double time_s;     // any monotonic clock, seconds
 } rouge_pointer_event;
@@ -331,8 +387,11 @@ rouge_result rouge_face_clear(rouge_face *face, rouge_error *err);  // undoable
 
 // --- looks and stroke files -------------------------------------------------------------------------------
 
+// Replaces the makeup with the look's and clears undo and redo (loading is not undoable). A look that
+// cannot be read or parsed, or was made on another face, leaves the makeup and undo as they were.
 rouge_result rouge_face_load_look(rouge_face *face, const char *path, rouge_error *err);
 rouge_result rouge_face_load_look_memory(rouge_face *face, const void *data, size_t size, rouge_error *err);
+// ROUGE_ERR_ARG for the .rsf the face was loaded from (compared by device and inode).
 rouge_result rouge_face_save_look(rouge_face *face, const char *path, rouge_error *err);
 // *data (free with rouge_free) holds *size bytes of look text.
 rouge_result rouge_face_save_look_memory(rouge_face *face, char **data, size_t *size, rouge_error *err);
@@ -343,6 +402,7 @@ rouge_result rouge_face_set_compare_look(rouge_face *face, const char *path, rou
 // recording is rewritten atomically on a background thread (never a half-written file, and no disk wait
 // on the pointer path); a failed write is returned by a later rouge_face_pointer, rouge_face_flush_strokes
 // or rouge_face_record_strokes call. Stopping (or destroying the face) writes what is pending first.
+// A directory or the face's own .rsf is refused at once (the recording so far goes on then).
 rouge_result rouge_face_record_strokes(rouge_face *face, const char *path, rouge_error *err);
 // Waits until every finished stroke is in the recording's file; returns a write failure, if any.
 rouge_result rouge_face_flush_strokes(rouge_face *face, rouge_error *err);

@@ -20,6 +20,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#ifdef __EMSCRIPTEN__
+#include <emscripten/html5.h>
+#else
+#include <EGL/egl.h>
+#endif
 
 // The public result codes are the library's, name for name.
 _Static_assert((int)ROUGE_ERR_ARG == (int)RS_ERR_ARG && (int)ROUGE_ERR_GL == (int)RS_ERR_GL, "rouge_result");
@@ -27,6 +34,7 @@ _Static_assert((int)ROUGE_MODE_COUNT == (int)RS_MODE_COUNT, "rouge_mode");
 _Static_assert(ROUGE_MAX_LODS == RS_SPLAT_MAX_LODS, "ROUGE_MAX_LODS");
 _Static_assert((int)ROUGE_COMPOSITE_PHYSICAL == (int)RS_COMPOSITE_PHYSICAL, "rouge_composite");
 _Static_assert(sizeof(((rouge_error *)0)->msg) == sizeof(((rs_error *)0)->msg), "rouge_error");
+_Static_assert(ROUGE_VIEW_MAX_SIZE == RS_VIEW_MAX_SIZE_PX, "ROUGE_VIEW_MAX_SIZE");
 
 #define ROUGE_ENV_MAX 64
 #define ROUGE_DEFAULT_SIZE 512
@@ -157,6 +165,12 @@ struct rouge_face {
     rec_writer *writer;           // writes it to its file off the pointer path
     uint32_t uploaded;            // records uploaded for the last frame
     rs_makeup *cmp;               // the compared look (rouge_face_set_compare_look), NULL = bare
+    uintptr_t context;            // the GL context the face was created in (its objects live there)
+    uint32_t host_gl_error;       // the first GL error a host left pending (rouge_face_take_host_gl_error)
+    bool have_source;             // loaded from a file: never overwrite it
+    rs_file_id source;
+    GLuint srgb_tex, srgb_pbo;    // draw into an sRGB framebuffer: the frame's bytes as sRGB texels
+    int srgb_w, srgb_h;
 };
 
 // A file arriving piece by piece: the splat loader behind a lock (one thread feeds, the GL thread makes
@@ -184,6 +198,14 @@ static rouge_result fail_arg(rouge_error *out, const char *what)
     return fail_out(out, &e);
 }
 
+// An output path must not name the .rsf the face was loaded from (the CLI refuses the same).
+static rs_result refuse_source(const rouge_face *f, const char *path, rs_error *e)
+{
+    if (f->have_source && rs_file_is(path, &f->source))
+        return rs_fail(e, RS_ERR_ARG, "%.400s is the file this face was loaded from: not overwriting it", path);
+    return RS_OK;
+}
+
 const char *rouge_result_name(rouge_result r)
 {
     static const char *const names[] = {"ROUGE_OK", "ROUGE_ERR_IO", "ROUGE_ERR_FORMAT", "ROUGE_ERR_LIMIT",
@@ -192,6 +214,16 @@ const char *rouge_result_name(rouge_result r)
 }
 
 void rouge_free(void *p) { free(p); }
+
+// The numbers are the header's; a host built against another header sees the difference here.
+#define ROUGE_STR2(x) #x
+#define ROUGE_STR(x) ROUGE_STR2(x)
+const char *rouge_version(void)
+{
+    return ROUGE_STR(ROUGE_VERSION_MAJOR) "." ROUGE_STR(ROUGE_VERSION_MINOR) "." ROUGE_STR(ROUGE_VERSION_PATCH);
+}
+
+uint32_t rouge_version_number(void) { return ROUGE_VERSION_NUMBER; }
 
 int rouge_environment_count(void) { return rs_env_name_count(); }
 const char *rouge_environment_name(int i) { return rs_env_name(i); }
@@ -216,6 +248,8 @@ rouge_result rouge_stream_create(const char *name, uint64_t total_bytes, rouge_s
 rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, rouge_error *err)
 {
     rs_error e = {0};
+    if (!s) return fail_arg(err, "stream: no stream");
+    if (!data && size) return fail_arg(err, "stream: no data for a non-zero size");
     pthread_mutex_lock(&s->mu);
     rs_result r = s->taken ? rs_fail(&e, RS_ERR_ARG, "stream: already handed to a face") : rs_splat_loader_feed(s->ld, data, size, &e);
     if (!r) s->bytes += size;
@@ -225,6 +259,7 @@ rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, r
 
 rouge_stream_progress rouge_stream_get_progress(rouge_stream *s)
 {
+    if (!s) return (rouge_stream_progress){0};
     pthread_mutex_lock(&s->mu);
     const rs_splat_header *h = rs_splat_loader_header(s->ld);
     rouge_stream_progress p = {.bytes = s->bytes, .splats = h ? h->count : 0,
@@ -264,22 +299,72 @@ static rs_result stream_cloud(rouge_stream *s, rs_splat_cloud **out, rs_error *e
 
 // --- the host's GL state -------------------------------------------------------------------------------------
 
+// The pixel-store state every transfer reads (glReadPixels, glTexImage*, glTexSubImage*), GL's defaults
+// while rouge runs: a host's row length or skips would make a transfer read or write outside rouge's
+// buffers. The renderer sets the alignment it needs itself.
+static const struct {
+    GLenum name;
+    GLint value;
+} pixel_store[] = {
+    {GL_PACK_ALIGNMENT, 4},   {GL_PACK_ROW_LENGTH, 0},     {GL_PACK_SKIP_PIXELS, 0},     {GL_PACK_SKIP_ROWS, 0},
+    {GL_UNPACK_ALIGNMENT, 4}, {GL_UNPACK_ROW_LENGTH, 0},   {GL_UNPACK_IMAGE_HEIGHT, 0},  {GL_UNPACK_SKIP_PIXELS, 0},
+    {GL_UNPACK_SKIP_ROWS, 0}, {GL_UNPACK_SKIP_IMAGES, 0},
+};
+#define PIXEL_STORE_COUNT 10
+_Static_assert(RS_COUNT_OF(pixel_store) == PIXEL_STORE_COUNT, "pixel_store");
+
+// The context current on this thread as a number; 0 when none (or one EGL does not know: GLX, WGL).
+static uintptr_t current_context(void)
+{
+#ifdef __EMSCRIPTEN__
+    // A WebGL context made through the html5 API is no EGL context.
+    return (uintptr_t)emscripten_webgl_get_current_context();
+#else
+    return (uintptr_t)eglGetCurrentContext();
+#endif
+}
+
+// A face's GL objects exist in the context it was created in: with none current, GL calls do nothing;
+// with another, the face's object names would name the host's own objects.
+static rs_result check_context(const rouge_face *f, rs_error *e)
+{
+    // 0: created in a context EGL does not know (GLX, WGL, CGL); it cannot be told apart, so trust it.
+    if (!f->context) return RS_OK;
+    uintptr_t now = current_context();
+    if (!now) return rs_fail(e, RS_ERR_GL, "no GL context is current on this thread (the face's must be)");
+    if (now != f->context)
+        return rs_fail(e, RS_ERR_GL, "another GL context is current, not the one the face was created in");
+    return RS_OK;
+}
+
 // Everything the renderer (or a blit) may change, saved on entry and put back on exit; on entry the
 // state the renderer assumes but never sets itself (no culling, scissor, stencil, polygon offset,
-// all colour channels written) is established.
+// all colour channels written, default pixel store) is established.
 typedef struct gl_saved {
     GLint draw_fbo, read_fbo, viewport[4], scissor_box[4];
     GLint program, vao, array_buffer, tf_buffer, pack_buffer, unpack_buffer;
     GLint active_texture, tex2d[MAX_TEXTURE_UNITS];
     GLint blend_src_rgb, blend_dst_rgb, blend_src_a, blend_dst_a, blend_eq_rgb, blend_eq_a;
-    GLint depth_func, pack_align, unpack_align;
+    GLint depth_func, pixel_store[PIXEL_STORE_COUNT];
     GLboolean depth_mask, color_mask[4];
     GLboolean blend, depth_test, scissor_test, stencil_test, cull_face, polygon_offset, discard, alpha_cov;
     GLfloat depth_clear;
 } gl_saved;
 
-static void gl_save(gl_saved *s)
+// Entry to every call that uses GL: the face's context must be current; errors the host left pending
+// are taken off the context (the renderer's checks must see only rouge's own, and GL cannot put them
+// back) and the first is kept for rouge_face_take_host_gl_error; then the state is saved. Nothing is
+// saved on failure (no gl_restore then).
+static rs_result gl_save(rouge_face *f, gl_saved *s, rs_error *e)
 {
+    rs_result r = check_context(f, e);
+    if (r) return r;
+    // Bounded: a lost context may report its loss more than once.
+    for (int i = 0; i < 32; i++) {
+        GLenum pending = glGetError();
+        if (pending == GL_NO_ERROR) break;
+        if (!f->host_gl_error) f->host_gl_error = pending;
+    }
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo);
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
     glGetIntegerv(GL_VIEWPORT, s->viewport);
@@ -302,8 +387,10 @@ static void gl_save(gl_saved *s)
     glGetIntegerv(GL_BLEND_EQUATION_RGB, &s->blend_eq_rgb);
     glGetIntegerv(GL_BLEND_EQUATION_ALPHA, &s->blend_eq_a);
     glGetIntegerv(GL_DEPTH_FUNC, &s->depth_func);
-    glGetIntegerv(GL_PACK_ALIGNMENT, &s->pack_align);
-    glGetIntegerv(GL_UNPACK_ALIGNMENT, &s->unpack_align);
+    for (int i = 0; i < PIXEL_STORE_COUNT; i++) {
+        glGetIntegerv(pixel_store[i].name, &s->pixel_store[i]);
+        glPixelStorei(pixel_store[i].name, pixel_store[i].value);
+    }
     glGetBooleanv(GL_DEPTH_WRITEMASK, &s->depth_mask);
     glGetBooleanv(GL_COLOR_WRITEMASK, s->color_mask);
     glGetFloatv(GL_DEPTH_CLEAR_VALUE, &s->depth_clear);
@@ -324,6 +411,7 @@ static void gl_save(gl_saved *s)
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    return RS_OK;
 }
 
 static void gl_enable(GLenum cap, GLboolean on)
@@ -356,8 +444,7 @@ static void gl_restore(const gl_saved *s)
     glDepthMask(s->depth_mask);
     glClearDepthf(s->depth_clear);
     glColorMask(s->color_mask[0], s->color_mask[1], s->color_mask[2], s->color_mask[3]);
-    glPixelStorei(GL_PACK_ALIGNMENT, s->pack_align);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, s->unpack_align);
+    for (int i = 0; i < PIXEL_STORE_COUNT; i++) glPixelStorei(pixel_store[i].name, s->pixel_store[i]);
     gl_enable(GL_BLEND, s->blend);
     gl_enable(GL_DEPTH_TEST, s->depth_test);
     gl_enable(GL_SCISSOR_TEST, s->scissor_test);
@@ -372,6 +459,7 @@ rouge_result rouge_query_caps(rouge_caps *out, rouge_error *err)
 {
     rs_gl_caps c = {0};
     rs_error e = {0};
+    if (!out) return fail_arg(err, "caps: out is required");
     if (rs_gl_query_caps(&c, &e) != RS_OK) return fail_out(err, &e);
     if (c.major < 3) {
         rs_fail(&e, RS_ERR_GL, "the current context is GLES %d.%d; rouge needs 3.0", c.major, c.minor);
@@ -454,16 +542,61 @@ static void camera_changed(rouge_face *f)
     f->changed = true;
 }
 
+// Every field of a view the renderer would refuse later, named: a bad view fails at set_view (the
+// previous one stays), never at every later frame.
+static rs_result check_view(const rouge_view *v, rs_error *e)
+{
+    const struct {
+        const char *name;
+        int value, max;
+    } enums[] = {{"mode", (int)v->mode, ROUGE_MODE_COUNT - 1},
+                 {"pipeline", (int)v->pipeline, ROUGE_PIPELINE_REFERENCE},
+                 {"composite", (int)v->composite, ROUGE_COMPOSITE_PHYSICAL},
+                 {"primitive", (int)v->primitive, ROUGE_PRIMITIVE_QUADS}};
+    for (size_t i = 0; i < RS_COUNT_OF(enums); i++)
+        if (enums[i].value < 0 || enums[i].value > enums[i].max)
+            return rs_fail(e, RS_ERR_ARG, "view.%s %d is unknown (0..%d)", enums[i].name, enums[i].value,
+                           enums[i].max);
+    if (v->width < 0 || v->width > ROUGE_VIEW_MAX_SIZE)
+        return rs_fail(e, RS_ERR_ARG, "view.width %d is outside 0..%d", v->width, ROUGE_VIEW_MAX_SIZE);
+    if (v->height < 0 || v->height > ROUGE_VIEW_MAX_SIZE)
+        return rs_fail(e, RS_ERR_ARG, "view.height %d is outside 0..%d", v->height, ROUGE_VIEW_MAX_SIZE);
+    if (v->kernel_count != 0 && (v->kernel_count < 2 || v->kernel_count > 4))
+        return rs_fail(e, RS_ERR_ARG, "view.kernel_count %d is outside 2..4 (0 = 3)", v->kernel_count);
+    const struct {
+        const char *name;
+        float value;
+    } nums[] = {{"yaw_deg", v->yaw_deg}, {"pitch_deg", v->pitch_deg}, {"zoom", v->zoom}, {"fov_deg", v->fov_deg},
+                {"pan[0]", v->pan[0]}, {"pan[1]", v->pan[1]}, {"env_rotation_deg", v->env_rotation_deg},
+                {"key.yaw_deg", v->key.yaw_deg}, {"key.pitch_deg", v->key.pitch_deg},
+                {"key.color[0]", v->key.color[0]}, {"key.color[1]", v->key.color[1]},
+                {"key.color[2]", v->key.color[2]}, {"key.intensity", v->key.intensity},
+                {"fill.yaw_deg", v->fill.yaw_deg}, {"fill.pitch_deg", v->fill.pitch_deg},
+                {"fill.color[0]", v->fill.color[0]}, {"fill.color[1]", v->fill.color[1]},
+                {"fill.color[2]", v->fill.color[2]}, {"fill.intensity", v->fill.intensity},
+                {"ambient", v->ambient}, {"exposure", v->exposure}, {"background[0]", v->background[0]},
+                {"background[1]", v->background[1]}, {"background[2]", v->background[2]},
+                {"background[3]", v->background[3]}, {"specular_scale", v->specular_scale},
+                {"lod_density", v->lod_density}};
+    for (size_t i = 0; i < RS_COUNT_OF(nums); i++) {
+        float x = nums[i].value;
+        if (isnan(x)) return rs_fail(e, RS_ERR_ARG, "view.%s is NaN", nums[i].name);
+        if (isinf(x)) return rs_fail(e, RS_ERR_ARG, "view.%s is %sinf", nums[i].name, x < 0 ? "-" : "");
+        // The renderer's own bound on every number of a view.
+        if (fabsf(x) > 1e6f) return rs_fail(e, RS_ERR_ARG, "view.%s %g is beyond +-1e6", nums[i].name, x);
+    }
+    if (v->fov_deg != 0 && !(v->fov_deg >= RS_VIEW_FOV_MIN_DEG && v->fov_deg <= RS_VIEW_FOV_MAX_DEG))
+        return rs_fail(e, RS_ERR_ARG, "view.fov_deg %g is outside %g..%g (0 = 30)", v->fov_deg, RS_VIEW_FOV_MIN_DEG,
+                       RS_VIEW_FOV_MAX_DEG);
+    return RS_OK;
+}
+
 rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_error *err)
 {
+    if (!f) return fail_arg(err, "view: no face");
     rouge_view v = view ? *view : (rouge_view){0};
-    if ((unsigned)v.mode >= ROUGE_MODE_COUNT) return fail_arg(err, "view: unknown mode");
-    if ((unsigned)v.pipeline > ROUGE_PIPELINE_REFERENCE) return fail_arg(err, "view: unknown pipeline");
-    if ((unsigned)v.composite > ROUGE_COMPOSITE_PHYSICAL) return fail_arg(err, "view: unknown composite");
-    if ((unsigned)v.primitive > ROUGE_PRIMITIVE_QUADS) return fail_arg(err, "view: unknown primitive");
-    if (v.width < 0 || v.height < 0) return fail_arg(err, "view: negative size");
-    if (!isfinite(v.env_rotation_deg) || fabsf(v.env_rotation_deg) > 1e6f)
-        return fail_arg(err, "view: environment rotation not a finite, sane number");
+    rs_error ve = {0};
+    if (check_view(&v, &ve)) return fail_out(err, &ve);
     const char *env = v.env && v.env[0] ? v.env : RS_ENV_DEFAULT;
     if (strlen(env) >= ROUGE_ENV_MAX) return fail_arg(err, "view: environment name or path too long");
     if (!rs_env_is_paper(env) && strcmp(env, f->env_name) != 0) {
@@ -472,9 +605,8 @@ rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_er
         rs_env *e_cpu = NULL;
         rs_error e = {0};
         rs_result r = rs_env_open(env, f->env_dir, &e_cpu, &e);
-        if (r == RS_OK) {
-            gl_saved s;
-            gl_save(&s);
+        gl_saved s;
+        if (r == RS_OK && (r = gl_save(f, &s, &e)) == RS_OK) {
             r = rs_render_set_env(f->ren, e_cpu, &e);
             gl_restore(&s);
         }
@@ -499,10 +631,11 @@ rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_er
     return ROUGE_OK;
 }
 
-rouge_view rouge_face_get_view(const rouge_face *f) { return f->view; }
+rouge_view rouge_face_get_view(const rouge_face *f) { return f ? f->view : (rouge_view){0}; }
 
 rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, rouge_error *err)
 {
+    if (!f) return fail_arg(err, "target: no face");
     const rs_splat_header *h = &f->cloud->hdr;
     int idx = -1;
     char names[RS_SPLAT_MAX_REGIONS * 17] = "";
@@ -588,6 +721,7 @@ rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, ro
 
 void rouge_face_orbit(rouge_face *f, float yaw_deg, float pitch_deg)
 {
+    if (!f || !isfinite(yaw_deg) || !isfinite(pitch_deg)) return;
     f->view.yaw_deg = fmodf(f->view.yaw_deg + yaw_deg, 360.0f);
     f->view.pitch_deg = RS_CLAMP(f->view.pitch_deg + pitch_deg, -PITCH_LIMIT_DEG, PITCH_LIMIT_DEG);
     camera_changed(f);
@@ -595,6 +729,7 @@ void rouge_face_orbit(rouge_face *f, float yaw_deg, float pitch_deg)
 
 void rouge_face_pan(rouge_face *f, float dx_px, float dy_px)
 {
+    if (!f || !isfinite(dx_px) || !isfinite(dy_px)) return;
     const rs_view *fv = pointer_view(f);
     f->view.pan[0] += dx_px / (float)fv->height;
     f->view.pan[1] += dy_px / (float)fv->height;
@@ -603,6 +738,7 @@ void rouge_face_pan(rouge_face *f, float dx_px, float dy_px)
 
 void rouge_face_zoom_at(rouge_face *f, float factor, float x_px, float y_px)
 {
+    if (!f || !isfinite(factor) || !isfinite(x_px) || !isfinite(y_px)) return;
     const rs_view *fv = pointer_view(f);
     float z0 = f->view.zoom > 0 ? f->view.zoom : 1.0f, z1 = RS_CLAMP(z0 * factor, ZOOM_MIN, ZOOM_MAX);
     if (!(factor > 0) || z1 == z0) return;
@@ -621,7 +757,8 @@ static bool pick_cb(void *user, float x, float y, uint32_t *idx, float hit[3])
 {
     rouge_face *f = user;
     gl_saved s;
-    gl_save(&s);
+    rs_error ignored = {0};
+    if (gl_save(f, &s, &ignored)) return false;
     bool ok = rs_render_pick(f->ren, pointer_view(f), x, y, idx, hit);
     gl_restore(&s);
     return ok;
@@ -651,6 +788,9 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
     if (rs_gl_query_caps(&caps, &e) != RS_OK) return fail_out(err, &e);
     rouge_face *f = calloc(1, sizeof *f);
     if (!f) return rs_fail(&e, RS_ERR_NOMEM, "out of memory"), fail_out(err, &e);
+    f->context = current_context();
+    // The file stays the face's input: saving over it would destroy the face (compared by identity).
+    f->have_source = desc->path && rs_file_id_of(desc->path, &f->source);
     f->manual_navigation = desc->manual_navigation;
     f->painting = true;
     if (desc->env_dir) {
@@ -665,12 +805,12 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
                   : desc->stream ? stream_cloud(desc->stream, &f->cloud, &e)
                                  : rs_splat_load_memory(desc->data, desc->size, &f->cloud, &e);
     gl_saved s;
-    gl_save(&s);
-    if (!r)
+    if (!r && !(r = gl_save(f, &s, &e))) {
         r = rs_render_create(&(rs_render_desc){.cloud = f->cloud, .caps = &caps,
                                                .force_no_float_targets = desc->no_float_targets},
                              &f->ren, &e);
-    gl_restore(&s);
+        gl_restore(&s);
+    }
     if (!r) r = rs_makeup_create(f->cloud, &(rs_makeup_desc){.undo_levels = desc->undo_levels}, &f->mk, &e);
     rs_paint_picker pk = {.user = f, .pick = pick_cb, .pixels_per_unit = ppu_cb, .view_dir = dir_cb};
     if (!r) r = rs_paint_create(f->mk, &pk, &(rs_paint_desc){.input.mode = RS_INPUT_PAINT}, &f->paint, &e);
@@ -700,9 +840,13 @@ void rouge_face_destroy(rouge_face *f)
     rs_paint_destroy(f->paint);
     rs_makeup_destroy(f->mk);
     rs_makeup_destroy(f->cmp);
-    if (f->ren) {
-        gl_saved s;
-        gl_save(&s);
+    gl_saved s;
+    rs_error e = {0};
+    // Only in the face's own context: in another, its object names would delete the host's objects, so
+    // the renderer is leaked instead.
+    if ((f->ren || f->srgb_tex) && !gl_save(f, &s, &e)) {
+        glDeleteTextures(1, &f->srgb_tex);
+        glDeleteBuffers(1, &f->srgb_pbo);
         rs_render_destroy(f->ren);
         gl_restore(&s);
     }
@@ -732,6 +876,9 @@ static rs_result flush_makeup(rouge_face *f, rs_error *e)
 // GL state is saved by the caller.
 static rs_result render_at(rouge_face *f, int w, int h, rs_error *e)
 {
+    if (w > RS_VIEW_MAX_SIZE_PX || h > RS_VIEW_MAX_SIZE_PX)
+        return rs_fail(e, RS_ERR_LIMIT, "frame %dx%d is over the %d pixel limit (set view.width and height)", w, h,
+                       RS_VIEW_MAX_SIZE_PX);
     rs_result r = flush_makeup(f, e);
     rs_view v = to_rs_view(&f->view, w, h);
     if (!r && f->view.compare_look && f->cmp) {
@@ -760,7 +907,8 @@ rouge_result rouge_face_render(rouge_face *f, rouge_error *err)
 {
     rs_error e = {0};
     gl_saved s;
-    gl_save(&s);
+    if (!f) return fail_arg(err, "render: no face");
+    if (gl_save(f, &s, &e)) return fail_out(err, &e);
     int w = f->view.width > 0 ? f->view.width : ROUGE_DEFAULT_SIZE;
     int h = f->view.height > 0 ? f->view.height : ROUGE_DEFAULT_SIZE;
     rs_result r = render_at(f, w, h, &e);
@@ -768,11 +916,52 @@ rouge_result rouge_face_render(rouge_face *f, rouge_error *err)
     return r ? fail_out(err, &e) : ROUGE_OK;
 }
 
+// True when the framebuffer bound for drawing stores sRGB (SRGB8_ALPHA8, an sRGB EGL surface): GL then
+// encodes what a blit writes. Its first draw buffer speaks for all.
+static bool draw_target_is_srgb(void)
+{
+    GLint buf = GL_NONE, type = GL_NONE, enc = GL_LINEAR;
+    glGetIntegerv(GL_DRAW_BUFFER0, &buf);
+    if (buf != GL_NONE)
+        glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, (GLenum)buf, GL_FRAMEBUFFER_ATTACHMENT_OBJECT_TYPE,
+                                              &type);
+    if (type != GL_NONE)
+        glGetFramebufferAttachmentParameteriv(GL_DRAW_FRAMEBUFFER, (GLenum)buf,
+                                              GL_FRAMEBUFFER_ATTACHMENT_COLOR_ENCODING, &enc);
+    // A surfaceless context's framebuffer 0 has nothing to ask: an error of rouge's own query, not the copy's.
+    for (int i = 0; i < 32 && glGetError() != GL_NO_ERROR; i++) {
+    }
+    return type != GL_NONE && enc == GL_SRGB;
+}
+
+// The frame's bytes (sRGB already) into an SRGB8_ALPHA8 texture of the face's, through a pixel buffer (no
+// CPU round trip): blitting from it decodes to linear and the sRGB target encodes back, so the picture is
+// encoded once. The frame is attached for reading.
+static GLuint srgb_copy(rouge_face *f, int w, int h)
+{
+    if (!f->srgb_tex) glGenTextures(1, &f->srgb_tex), glGenBuffers(1, &f->srgb_pbo);
+    glBindTexture(GL_TEXTURE_2D, f->srgb_tex);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, f->srgb_pbo);
+    if (f->srgb_w != w || f->srgb_h != h) {
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_SRGB8_ALPHA8, w, h, 0, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glBufferData(GL_PIXEL_PACK_BUFFER, (GLsizeiptr)w * h * 4, NULL, GL_STREAM_COPY);
+        f->srgb_w = w, f->srgb_h = h;
+    }
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, f->srgb_pbo);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, NULL);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+    return f->srgb_tex;
+}
+
 rouge_result rouge_face_draw(rouge_face *f, int x, int y, int w, int h, rouge_error *err)
 {
     rs_error e = {0};
     gl_saved s;
-    gl_save(&s);
+    if (!f) return fail_arg(err, "draw: no face");
+    if (gl_save(f, &s, &e)) return fail_out(err, &e);
     if (w <= 0 || h <= 0) x = s.viewport[0], y = s.viewport[1], w = s.viewport[2], h = s.viewport[3];
     rs_result r = RS_OK;
     if (w <= 0 || h <= 0) r = rs_fail(&e, RS_ERR_ARG, "draw: empty rectangle %dx%d", w, h);
@@ -787,6 +976,8 @@ rouge_result rouge_face_draw(rouge_face *f, int x, int y, int w, int h, rouge_er
         glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, 0);
         glReadBuffer(GL_COLOR_ATTACHMENT0);
         glBindFramebuffer(GL_DRAW_FRAMEBUFFER, (GLuint)s.draw_fbo);
+        if (draw_target_is_srgb())
+            glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, srgb_copy(f, rw, rh), 0);
         glBlitFramebuffer(0, 0, rw, rh, x, y, x + w, y + h, GL_COLOR_BUFFER_BIT,
                           rw == w && rh == h ? GL_NEAREST : GL_LINEAR);
         glBindFramebuffer(GL_READ_FRAMEBUFFER, 0);
@@ -799,6 +990,11 @@ rouge_result rouge_face_draw(rouge_face *f, int x, int y, int w, int h, rouge_er
 
 uint32_t rouge_face_texture(const rouge_face *f, int *width, int *height)
 {
+    if (!f) {
+        if (width) *width = 0;
+        if (height) *height = 0;
+        return 0;
+    }
     return rs_render_output_texture(f->ren, width, height);
 }
 
@@ -807,7 +1003,8 @@ rouge_result rouge_face_read_rgba(rouge_face *f, uint8_t *rgba, size_t capacity,
     rs_error e = {0};
     rs_image img = {0};
     gl_saved s;
-    gl_save(&s);
+    if (!f) return fail_arg(err, "read: no face");
+    if (gl_save(f, &s, &e)) return fail_out(err, &e);
     rs_result r = rs_render_read(f->ren, &img, &e);
     gl_restore(&s);
     size_t need = (size_t)img.width * (size_t)img.height * 4;
@@ -823,7 +1020,9 @@ rouge_result rouge_face_write_png(rouge_face *f, const char *path, rouge_error *
     rs_error e = {0};
     rs_image img = {0};
     gl_saved s;
-    gl_save(&s);
+    if (!f) return fail_arg(err, "png: no face");
+    if (!path) return fail_arg(err, "png: no path");
+    if (refuse_source(f, path, &e) || gl_save(f, &s, &e)) return fail_out(err, &e);
     rs_result r = rs_render_read(f->ren, &img, &e);
     gl_restore(&s);
     if (!r) r = rs_image_write_png(path, &img, &e);
@@ -831,7 +1030,15 @@ rouge_result rouge_face_write_png(rouge_face *f, const char *path, rouge_error *
     return r ? fail_out(err, &e) : ROUGE_OK;
 }
 
-bool rouge_face_changed(const rouge_face *f) { return f->changed || !f->have_frame; }
+bool rouge_face_changed(const rouge_face *f) { return f && (f->changed || !f->have_frame); }
+
+uint32_t rouge_face_take_host_gl_error(rouge_face *f)
+{
+    if (!f) return 0;
+    uint32_t e = f->host_gl_error;
+    f->host_gl_error = 0;
+    return e;
+}
 
 // --- painting --------------------------------------------------------------------------------------------
 
@@ -840,7 +1047,7 @@ int rouge_cosmetic_count(void) { return (int)rs_cosmetic_count(); }
 bool rouge_cosmetic_get(int i, rouge_cosmetic *out)
 {
     const rs_cosmetic *c = i >= 0 ? rs_cosmetic_get((uint32_t)i) : NULL;
-    if (!c) return false;
+    if (!c || !out) return false;
     rs_cosmetic_region reg = rs_cosmetic_region_of(c);
     *out = (rouge_cosmetic){.name = c->name, .kind = rs_cosmetic_kind_name(c->kind), .size = c->size_rel,
                             .opacity = c->opacity, .finish = (rouge_finish)(rs_cosmetic_finish(c) + 1),
@@ -852,6 +1059,7 @@ bool rouge_cosmetic_get(int i, rouge_cosmetic *out)
 
 rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge_error *err)
 {
+    if (!f) return fail_arg(err, "brush: no face");
     rouge_brush b = brush ? *brush : (rouge_brush){0};
     const char *name = b.cosmetic ? b.cosmetic : "foundation_1";
     const rs_cosmetic *c = rs_cosmetic_find(name);
@@ -888,6 +1096,7 @@ rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge
 
 void rouge_face_set_painting(rouge_face *f, bool painting)
 {
+    if (!f) return;
     f->painting = painting;
     rs_paint_set_mode(f->paint, painting ? RS_INPUT_PAINT : RS_INPUT_VIEW);
 }
@@ -901,8 +1110,13 @@ static rs_strokes_view strokes_view(const rs_view *v)
 rouge_result rouge_face_pointer(rouge_face *f, const rouge_pointer_event *ev, rouge_pointer_result *out,
                                 rouge_error *err)
 {
+    if (!f) return fail_arg(err, "pointer: no face");
     if (!ev || (unsigned)ev->type > ROUGE_POINTER_CANCEL) return fail_arg(err, "pointer: unknown event type");
+    if (!isfinite(ev->x) || !isfinite(ev->y) || !isfinite(ev->pressure) || !isfinite(ev->time_s))
+        return fail_arg(err, "pointer: x, y, pressure and time_s must be finite");
     rs_error e = {0};
+    // Picks happen inside: without the face's context they would silently miss.
+    if (check_context(f, &e)) return fail_out(err, &e);
     const rs_view *fv = pointer_view(f);
     if (ev->type == ROUGE_POINTER_DOWN && f->rec) {
         // The stroke file records the camera the pixels refer to.
@@ -940,6 +1154,7 @@ rouge_result rouge_face_pointer(rouge_face *f, const rouge_pointer_event *ev, ro
 bool rouge_face_undo(rouge_face *f)
 {
     rs_makeup_range d;
+    if (!f) return false;
     bool ok = rs_makeup_undo(f->mk, &d);
     f->changed |= ok;
     return ok;
@@ -948,6 +1163,7 @@ bool rouge_face_undo(rouge_face *f)
 bool rouge_face_redo(rouge_face *f)
 {
     rs_makeup_range d;
+    if (!f) return false;
     bool ok = rs_makeup_redo(f->mk, &d);
     f->changed |= ok;
     return ok;
@@ -957,6 +1173,7 @@ rouge_result rouge_face_clear(rouge_face *f, rouge_error *err)
 {
     rs_error e = {0};
     rs_makeup_range d;
+    if (!f) return fail_arg(err, "clear: no face");
     f->changed = true;
     return rs_makeup_clear(f->mk, &d, &e) ? fail_out(err, &e) : ROUGE_OK;
 }
@@ -967,7 +1184,7 @@ rouge_result rouge_face_load_look(rouge_face *f, const char *path, rouge_error *
 {
     rs_error e = {0};
     rs_makeup_range d;
-    if (!path) return fail_arg(err, "look: no path");
+    if (!f || !path) return fail_arg(err, "look: no face or no path");
     rs_result r = rs_look_load(f->mk, path, &d, &e);
     f->changed = true;
     return r ? fail_out(err, &e) : ROUGE_OK;
@@ -978,6 +1195,7 @@ rouge_result rouge_face_load_look_memory(rouge_face *f, const void *data, size_t
     rs_error e = {0};
     rs_look *look = NULL;
     rs_makeup_range d;
+    if (!f || !data) return fail_arg(err, "look: no face or no data");
     rs_result r = rs_look_parse(data, size, &look, &e);
     if (!r) r = rs_look_apply(look, f->mk, &d, &e);
     rs_look_destroy(look);
@@ -988,20 +1206,21 @@ rouge_result rouge_face_load_look_memory(rouge_face *f, const void *data, size_t
 rouge_result rouge_face_save_look(rouge_face *f, const char *path, rouge_error *err)
 {
     rs_error e = {0};
-    if (!path) return fail_arg(err, "look: no path");
-    return rs_look_save(f->mk, path, &e) ? fail_out(err, &e) : ROUGE_OK;
+    if (!f || !path) return fail_arg(err, "look: no face or no path");
+    return refuse_source(f, path, &e) || rs_look_save(f->mk, path, &e) ? fail_out(err, &e) : ROUGE_OK;
 }
 
 rouge_result rouge_face_save_look_memory(rouge_face *f, char **data, size_t *size, rouge_error *err)
 {
     rs_error e = {0};
-    if (!data || !size) return fail_arg(err, "look: data and size are required");
+    if (!f || !data || !size) return fail_arg(err, "look: face, data and size are required");
     return rs_look_write_memory(f->mk, data, size, &e) ? fail_out(err, &e) : ROUGE_OK;
 }
 
 rouge_result rouge_face_set_compare_look(rouge_face *f, const char *path, rouge_error *err)
 {
     rs_error e = {0};
+    if (!f) return fail_arg(err, "compare look: no face");
     if (!path) {
         rs_makeup_destroy(f->cmp);
         f->cmp = NULL;
@@ -1024,6 +1243,12 @@ rouge_result rouge_face_set_compare_look(rouge_face *f, const char *path, rouge_
 rouge_result rouge_face_record_strokes(rouge_face *f, const char *path, rouge_error *err)
 {
     rs_error e = {0};
+    if (!f) return fail_arg(err, "strokes: no face");
+    struct stat st;
+    // Refused up front, the recording as it was goes on: a directory would only fail at the first write.
+    if (path && stat(path, &st) == 0 && S_ISDIR(st.st_mode))
+        return rs_fail(&e, RS_ERR_IO, "%.400s: is a directory, not a stroke file", path), fail_out(err, &e);
+    if (path && refuse_source(f, path, &e)) return fail_out(err, &e);
     rs_paint_set_recorder(f->paint, NULL, NULL);
     rs_result stopped = rec_writer_stop(f->writer, &e);
     rs_strokes_destroy(f->rec);
@@ -1044,6 +1269,7 @@ rouge_result rouge_face_record_strokes(rouge_face *f, const char *path, rouge_er
 rouge_result rouge_face_flush_strokes(rouge_face *f, rouge_error *err)
 {
     rs_error e = {0};
+    if (!f) return fail_arg(err, "strokes: no face");
     return f->writer && rec_writer_status(f->writer, true, &e) ? fail_out(err, &e) : ROUGE_OK;
 }
 
@@ -1051,7 +1277,9 @@ rouge_result rouge_face_play_strokes(rouge_face *f, const char *path, rouge_erro
 {
     rs_error e = {0};
     rs_strokes *doc = NULL;
-    if (!path) return fail_arg(err, "strokes: no path");
+    if (!f || !path) return fail_arg(err, "strokes: no face or no path");
+    // Each stamp picks through the face's ID buffer: without its context every one would miss.
+    if (check_context(f, &e)) return fail_out(err, &e);
     rs_result r = rs_strokes_load(path, &doc, &e);
     // Picks must see each stroke's camera and pixel grid: its view becomes the "last frame" while it plays.
     rs_view saved = f->frame_view;
@@ -1094,7 +1322,7 @@ bool rouge_face_pick(rouge_face *f, float x, float y, rouge_pick *out)
 {
     uint32_t idx;
     float hit[3];
-    if (!pick_cb(f, x, y, &idx, hit)) return false;
+    if (!f || !isfinite(x) || !isfinite(y) || !pick_cb(f, x, y, &idx, hit)) return false;
     if (out) {
         float ppu = rs_render_pixels_per_unit(f->ren, pointer_view(f), hit);
         *out = (rouge_pick){.splat = idx, .position = {hit[0], hit[1], hit[2]},
@@ -1106,6 +1334,7 @@ bool rouge_face_pick(rouge_face *f, float x, float y, rouge_pick *out)
 
 rouge_stats rouge_face_stats(const rouge_face *f)
 {
+    if (!f) return (rouge_stats){0};
     const rs_splat_header *h = &f->cloud->hdr;
     rs_render_stats rs = rs_render_get_stats(f->ren);
     rouge_stats s = {.splats = h->count, .lod_count = h->lod_count, .face_height_mm = h->face_height * h->mm_per_unit,

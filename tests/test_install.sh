@@ -4,7 +4,10 @@
 # examples/*.c builds with `pkg-config --cflags --libs rouge` against the installed tree (not the source
 # tree) and links the installed librouge.so; the installed embed_headless paints one stroke on the
 # installed face, and its PNG equals `rouge render` of the same view except where the stroke is; the
-# installed rouge finds its default face. About 10 s.
+# installed rouge finds its default face; the installed library finds its environments from any working
+# directory (beside its own lib/, though built for /usr/local); `pkg-config --libs rouge` needs no cglm.pc;
+# uninstall removes exactly what install added (another version's library and a user's .rse stay, the
+# lib/pkgconfig it made goes). About 10 s.
 build=${1:-build}
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
@@ -70,10 +73,29 @@ for src in examples/*.c; do
 done
 unset PKG_CONFIG_PATH PKG_CONFIG_SYSROOT_DIR
 
+# cglm is header-only and private to src/: a host without cglm.pc still gets rouge's flags.
+pcdir="$tmp/pc"
+mkdir -p "$pcdir"
+for d in $(pkg-config --variable pc_path pkg-config | tr ':' ' '); do
+    for f in "$d"/*.pc; do
+        [ -e "$f" ] && [ "$(basename "$f")" != cglm.pc ] && ln -sf "$f" "$pcdir/" 2>/dev/null
+    done
+done
+if PKG_CONFIG_LIBDIR="$pcdir:$root/usr/lib/pkgconfig" PKG_CONFIG_SYSROOT_DIR="$root" \
+    pkg-config --cflags --libs rouge >"$tmp/pc.out" 2>&1 && grep -q -- '-lrouge' "$tmp/pc.out"; then
+    ok install_pkg_config_needs_no_cglm
+else
+    fail install_pkg_config_needs_no_cglm "$(head -n 2 "$tmp/pc.out")"
+fi
+
 # embed_headless: a PNG of the face with one lipstick stroke; the same view through `rouge render` (the
 # mobile pipeline, the defaults) is the reference: identical but for the stroke.
+# Run from a folder without assets/: the installed library (built for /usr/local, installed to /usr under
+# a DESTDIR) must find its environments beside itself, not in the working directory.
+mkdir -p "$tmp/elsewhere"
 if [ -x "$tmp/embed_headless" ]; then
-    if LD_LIBRARY_PATH="$root/usr/lib" "$tmp/embed_headless" "$root/usr/share/rouge/face.rsf" "$tmp/eh.png" 2>"$tmp/err"; then
+    if (cd "$tmp/elsewhere" && LD_LIBRARY_PATH="$root/usr/lib" "$tmp/embed_headless" "$root/usr/share/rouge/face.rsf" \
+        "$tmp/eh.png") 2>"$tmp/err"; then
         "$build/rouge" render "$root/usr/share/rouge/face.rsf" -o "$tmp/ref.png" --size 512x512 --pipeline mobile >/dev/null 2>&1
         "$build/rouge-imgdiff" "$tmp/ref.png" "$tmp/eh.png" --threshold 8 >"$tmp/m8" 2>&1
         "$build/rouge-imgdiff" "$tmp/ref.png" "$tmp/eh.png" --threshold 0 >"$tmp/m0" 2>&1
@@ -93,7 +115,6 @@ if [ -x "$tmp/embed_headless" ]; then
 fi
 
 # The installed program opens its installed face when none is named (from a directory without assets/).
-mkdir -p "$tmp/elsewhere"
 if (cd "$tmp/elsewhere" && "$root/usr/bin/rouge" render -o x.png --size 32x32 --max-splats 2000 >/dev/null 2>"$tmp/err") &&
     [ -s "$tmp/elsewhere/x.png" ]; then
     ok install_rouge_finds_its_face
@@ -101,9 +122,13 @@ else
     fail install_rouge_finds_its_face "$(head -n 1 "$tmp/err")"
 fi
 
+# What is not install's stays: another version's library and an environment the user added.
+echo other >"$root/usr/lib/librouge.so.0.9.0"
+echo mine >"$root/usr/share/rouge/env/mine.rse"
 if make --no-print-directory -s BUILD="$build" uninstall DESTDIR="$root" PREFIX=/usr >"$tmp/log" 2>&1 &&
-    [ -z "$(find "$root" -type f -o -type l)" ]; then
-    ok install_uninstall_removes_everything
+    [ "$(cd "$root" && find . -type f -o -type l | sort | tr '\n' ' ')" = "./usr/lib/librouge.so.0.9.0 ./usr/share/rouge/env/mine.rse " ] &&
+    [ ! -d "$root/usr/lib/pkgconfig" ]; then
+    ok install_uninstall_removes_exactly_what_it_added
 else
-    fail install_uninstall_removes_everything "left: $(find "$root" -type f -o -type l | head -3 | tr '\n' ' ')"
+    fail install_uninstall_removes_exactly_what_it_added "left: $(cd "$root" && find . -type f -o -type l | head -4 | tr '\n' ' ')$([ -d "$root/usr/lib/pkgconfig" ] && echo 'and lib/pkgconfig')"
 fi

@@ -211,6 +211,26 @@ static bool write_all(int fd, const void *data, size_t len)
     return true;
 }
 
+bool rs_file_id_of(const char *path, rs_file_id *out)
+{
+    struct stat st;
+    if (!path || stat(path, &st) != 0) return false;
+    *out = (rs_file_id){(uint64_t)st.st_dev, (uint64_t)st.st_ino};
+    return true;
+}
+
+bool rs_file_is(const char *path, const rs_file_id *id)
+{
+    rs_file_id f;
+    return id && rs_file_id_of(path, &f) && f.dev == id->dev && f.ino == id->ino;
+}
+
+bool rs_same_file(const char *a, const char *b)
+{
+    rs_file_id ib;
+    return rs_file_id_of(b, &ib) && rs_file_is(a, &ib);
+}
+
 rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err)
 {
     // Only ever replace a regular file: renaming over /dev/null, a FIFO or a socket would destroy it.

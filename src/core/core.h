@@ -71,6 +71,17 @@ bool rs_array_grow(void **ptr, uint32_t *cap, uint32_t need, size_t elem);
 rs_result rs_file_read_all(const char *path, size_t max_bytes, void **out_data, size_t *out_len, rs_error *err);
 // Writes via "<path>.tmp.<pid>" then fsync + rename: readers see the old or the new file, never a mix.
 rs_result rs_file_write_atomic(const char *path, const void *data, size_t len, rs_error *err);
+// A file's identity (device + inode): one file under any of its names (hard links, ./x and x). The CLI's
+// and the library's "do not overwrite the input" checks both compare these.
+typedef struct rs_file_id {
+    uint64_t dev, ino;
+} rs_file_id;
+// False when `path` is NULL or names nothing (*out untouched).
+bool rs_file_id_of(const char *path, rs_file_id *out);
+// True when `path` names the file `id` identifies.
+bool rs_file_is(const char *path, const rs_file_id *id);
+// True when `a` and `b` name the same existing file.
+bool rs_same_file(const char *a, const char *b);
 
 // Little-endian fields of binary files (every rouge format is little-endian, whatever the host).
 static inline uint32_t rs_le32_get(const uint8_t *p)

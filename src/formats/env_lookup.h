@@ -23,8 +23,9 @@ int rs_env_name_count(void);
 bool rs_env_is_paper(const char *name);
 
 // Loads environment `name` (NULL or "" = RS_ENV_DEFAULT): a bundled name, looked up as NAME.rse in `dir`
-// (when given), assets/env (a source tree) and the install's share/rouge/env, in that order; or a path
-// to a .rse file. The error names what was
+// (when given), beside the file the library runs from (dladdr: <prefix>/share/rouge/env of an installed
+// package, <tree>/assets/env of a build tree) and RS_DATADIR/env, in that order (never relative to the
+// working directory); or a path to a .rse file. The error names what was
 // tried: "environment 'nosuch': not one of studio|daylight|office|sunset|paper and no file nosuch".
 rs_result rs_env_open(const char *name, const char *dir, rs_env **out, rs_error *err);
 
