@@ -165,13 +165,18 @@ void rs_ui_begin(rs_ui *ui, int fb_w, int fb_h, float scale, const rs_ui_input *
 
 float rs_ui_scale(const rs_ui *ui) { return ui->scale; }
 
-void rs_ui_end(rs_ui *ui)
+void rs_ui_end_input(rs_ui *ui)
 {
     // This frame's hit areas become the ones rs_ui_captures answers from.
     memcpy(ui->hits[1], ui->hits[0], sizeof ui->hits[0]);
     ui->nhits[1] = ui->nhits[0];
     // A widget only keeps the pointer while the button is held.
     if (!ui->in.down) ui->active = 0;
+}
+
+void rs_ui_end(rs_ui *ui)
+{
+    rs_ui_end_input(ui);
     if (ui->nv == 0) return;
     size_t bytes = ui->nv * sizeof(vtx);
     glBindBuffer(GL_ARRAY_BUFFER, ui->vbo);
@@ -217,7 +222,6 @@ bool rs_ui_captures(const rs_ui *ui, float x, float y)
     return false;
 }
 
-bool rs_ui_busy(const rs_ui *ui) { return ui->active != 0; }
 
 void rs_ui_pointer(const rs_ui *ui, float *x, float *y)
 {

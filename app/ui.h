@@ -81,13 +81,14 @@ void rs_ui_destroy(rs_ui *ui);
 void rs_ui_begin(rs_ui *ui, int fb_w, int fb_h, float scale, const rs_ui_input *in);
 // Draws the frame's list into the bound framebuffer (viewport = fb size) with premultiplied blending.
 void rs_ui_end(rs_ui *ui);
+// Ends a frame without drawing it: an input-only pass, so widgets see every press, move and release in
+// order however many arrive between two drawn frames (one state per frame would lose a quick tap or flick).
+void rs_ui_end_input(rs_ui *ui);
 float rs_ui_scale(const rs_ui *ui);
 
 // True when (x, y) lies on something interactive or on a panel drawn in the last finished frame, or a
 // widget holds the pointer (a slider being dragged): the press belongs to the UI, not to the scene.
 bool rs_ui_captures(const rs_ui *ui, float x, float y);
-// True while a widget holds the pointer.
-bool rs_ui_busy(const rs_ui *ui);
 // The pointer position of this frame, framebuffer pixels.
 void rs_ui_pointer(const rs_ui *ui, float *x, float *y);
 

@@ -60,9 +60,9 @@ const vw_shortcut vw_shortcuts[] = {
     {"Delete", "clear all makeup"},
     {"A, D, F", "albedo / diffuse / full"},
     {"R", "mobile / reference pipeline"},
-    {"B", "before/after split"},
+    {"B", "split: bare face vs current look"},
     {"I", "HUD: frame time, LOD"},
-    {"S", "screenshot (rouge-NNNN.png)"},
+    {"S", "export the picture and its look (asks where)"},
     {"Ctrl+S, Ctrl+O", "save a look / the look library"},
     {"F11, Ctrl+Q", "full screen, quit"},
     {"H or ?, Esc", "help; Esc closes help/split"},
@@ -91,7 +91,9 @@ void rs_app_print_viewer_help(FILE *f)
             "  scroll DY | key NAME (p, [, ?, ctrl+z, shift+tab, f11, esc, ...) | type TEXT | touch ID down|move|up X Y\n"
             "  drop FILE | step S (script clock per pointer event, default 1/60 s) | frames N | wait S\n"
             "  idle (until full quality) | screenshot FILE [X Y W H] (PNG of the window or a region, after\n"
-            "  idle) | wait-for FILE (until FILE exists) | loaded (until the face file has loaded) | quit\n");
+            "  idle) | wait-for FILE (until FILE exists) | loaded (until the face file has loaded) | quit\n"
+            "  keydown NAME, keyup NAME (a key held: L+drag) | slow S (every frame takes S seconds, events arrive\n"
+            "  in real time: a slow device) | state FILE (camera, light, editor colour, events applied)\n");
 }
 
 // The viewer's own options: --events, --bench-orbit, and whether --size / --pipeline were given.
@@ -284,19 +286,20 @@ static void reset_camera(vw_viewer *v)
     v->dirty_view = true;
 }
 
-static void orbit(vw_viewer *v, float dx_px, float dy_px)
+// Drags in window coordinates (points): the same drag turns the face as far at any render scale, LOD
+// or pixel density. Drag right turns the face to the right (the camera goes left); drag down shows it
+// from above.
+static void orbit(vw_viewer *v, float dx_pt, float dy_pt)
 {
-    float k = ORBIT_DEG_PER_PT / v->px_per_pt;
-    // Drag right turns the face to the right (the camera goes left); drag down shows it from above.
-    v->view.yaw_deg = fmodf(v->view.yaw_deg - dx_px * k, 360.0f);
-    v->view.pitch_deg = RS_CLAMP(v->view.pitch_deg + dy_px * k, -80.0f, 80.0f);
+    v->view.yaw_deg = fmodf(v->view.yaw_deg - dx_pt * ORBIT_DEG_PER_PT, 360.0f);
+    v->view.pitch_deg = RS_CLAMP(v->view.pitch_deg + dy_pt * ORBIT_DEG_PER_PT, -80.0f, 80.0f);
     v->dirty_view = true;
 }
 
-static void pan(vw_viewer *v, float dx_px, float dy_px)
+static void pan(vw_viewer *v, float dx_pt, float dy_pt)
 {
-    v->view.pan[0] += dx_px / (float)v->fb_h;
-    v->view.pan[1] += dy_px / (float)v->fb_h;
+    v->view.pan[0] += dx_pt / (float)v->win_h;
+    v->view.pan[1] += dy_pt / (float)v->win_h;
     v->dirty_view = true;
 }
 
@@ -523,13 +526,13 @@ static void toggle_fullscreen(vw_viewer *v)
 
 static bool at_full_quality(const vw_viewer *v);
 
-static bool next_screenshot_name(vw_viewer *v, char *out, size_t n)
+// B and the split button: always the bare face against the current look (a look from the library is
+// compared from its card on the sheet).
+static void toggle_split(vw_viewer *v)
 {
-    for (int i = 0; i < 10000; i++) {
-        snprintf(out, n, "rouge-%04d.png", ++v->shot_counter);
-        if (access(out, F_OK) != 0) return true;
-    }
-    return false;
+    v->split = !v->split;
+    if (v->split) vw_looks_compare_bare(v);
+    v->dirty_view = true;
 }
 
 static void key_action(vw_viewer *v, int key, int mods)
@@ -554,7 +557,7 @@ static void key_action(vw_viewer *v, int key, int mods)
         v->view.pipeline = v->view.pipeline == ROUGE_PIPELINE_REFERENCE ? ROUGE_PIPELINE_MOBILE : ROUGE_PIPELINE_REFERENCE;
         v->dirty_view = true;
         break;
-    case GLFW_KEY_B: v->split = !v->split, v->dirty_view = true; break;
+    case GLFW_KEY_B: toggle_split(v); break;
     case GLFW_KEY_I: v->hud = !v->hud; break;
     case GLFW_KEY_H: v->help = !v->help; break;
     case GLFW_KEY_SLASH: if (shift) v->help = !v->help; break;
@@ -564,7 +567,7 @@ static void key_action(vw_viewer *v, int key, int mods)
         break;
     case GLFW_KEY_S:
         if (ctrl) vw_looks_begin_save(v);
-        else v->want_face_shot = true;
+        else vw_looks_begin_export(v);
         break;
     case GLFW_KEY_O:
         if (ctrl) vw_looks_open(v);
@@ -580,10 +583,10 @@ static void key_action(vw_viewer *v, int key, int mods)
         vw_apply_brush(v);
         break;
     }
-    case GLFW_KEY_LEFT: orbit(v, -40 * v->px_per_pt, 0), mark_input(v); break;
-    case GLFW_KEY_RIGHT: orbit(v, 40 * v->px_per_pt, 0), mark_input(v); break;
-    case GLFW_KEY_UP: orbit(v, 0, -40 * v->px_per_pt), mark_input(v); break;
-    case GLFW_KEY_DOWN: orbit(v, 0, 40 * v->px_per_pt), mark_input(v); break;
+    case GLFW_KEY_LEFT: orbit(v, -40, 0), mark_input(v); break;
+    case GLFW_KEY_RIGHT: orbit(v, 40, 0), mark_input(v); break;
+    case GLFW_KEY_UP: orbit(v, 0, -40), mark_input(v); break;
+    case GLFW_KEY_DOWN: orbit(v, 0, 40), mark_input(v); break;
     case GLFW_KEY_EQUAL:
     case GLFW_KEY_KP_ADD: zoom_at(v, ZOOM_STEP, (float)v->fb_w * 0.5f, (float)v->fb_h * 0.5f), mark_input(v); break;
     case GLFW_KEY_MINUS:
@@ -606,21 +609,44 @@ static void key_action(vw_viewer *v, int key, int mods)
 
 // --- input routing -------------------------------------------------------------------------------------
 
-static void feed_paint(vw_viewer *v, rouge_pointer_type type, int id, float x, float y, double t)
+static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st, int sw);
+
+// One UI pass for the pointer as it is now, drawn nowhere: each press, move and release of a batch gets
+// its own, so a tap or a flick that starts and ends between two drawn frames still acts (the widgets
+// see every state in order, not only the batch's last).
+static void ui_pass(vw_viewer *v)
+{
+    rs_ui_toolbar_state st;
+    int sw = -1;
+    v->ui_input_only = true;
+    rs_ui_tool t = vw_draw_ui(v, &st, &sw);
+    v->ui_input_only = false;
+    rs_ui_end_input(v->ui);
+    apply_tool(v, t, &st, sw);
+}
+
+// A pointer for the face (painting, touch gestures), in window coordinates. A gesture is measured in one
+// pixel scale from its first touch to its last (the face_scale of its first DOWN); render_scene keeps the
+// picture at that scale while a stroke picks in it.
+static void feed_face(vw_viewer *v, rouge_pointer_type type, int id, float wx, float wy, double t)
 {
     if (!v->face) return;
-    // The face picks through the camera on screen, in the pixels of its last frame.
-    if (type == ROUGE_POINTER_DOWN) push_view(v);
-    float k = v->render_scale;
-    rouge_pointer_event ev = {type, id, x * k, y * k, 1.0f, t};
+    if (type == ROUGE_POINTER_DOWN) {
+        if (v->face_pointers++ == 0) v->face_scale = v->render_scale;
+        // The face picks through the camera on screen.
+        push_view(v);
+    }
+    float k = v->face_scale * v->px_per_pt;  // face pixels per window coordinate
+    rouge_pointer_event ev = {type, id, wx * k, wy * k, 1.0f, t};
     rouge_pointer_result res;
     rouge_error e = {0};
     if (rouge_face_pointer(v->face, &ev, &res, &e) != ROUGE_OK) vw_toast(v, true, "%s", e.msg);
-    // Gestures come back in the frame's pixels; the viewer navigates in framebuffer pixels.
+    if (type == ROUGE_POINTER_UP || type == ROUGE_POINTER_CANCEL) v->face_pointers = RS_MAX(v->face_pointers - 1, 0);
+    // Gestures come back in the face's pixels: back to window coordinates with the same scale.
     if (res.orbit_dx != 0 || res.orbit_dy != 0) orbit(v, res.orbit_dx / k, res.orbit_dy / k);
     if (res.pan_dx != 0 || res.pan_dy != 0) pan(v, res.pan_dx / k, res.pan_dy / k);
     bool zoomed = res.zoom != 1.0f && res.zoom > 0;
-    if (zoomed) zoom_at(v, res.zoom, res.zoom_x / k, res.zoom_y / k);
+    if (zoomed) zoom_at(v, res.zoom, res.zoom_x / v->face_scale, res.zoom_y / v->face_scale);
     if (res.stamps || res.stroke_end || res.stroke_cancel) v->dirty_makeup = true;
     // Navigation coarsens the picture while it moves; painting does not: the view stays, so the face
     // redraws only what the stamps touched (incremental frames) at full quality.
@@ -631,44 +657,54 @@ static void feed_paint(vw_viewer *v, rouge_pointer_type type, int id, float x, f
 static void pointer_button(vw_viewer *v, int b, bool down, double t)
 {
     if (down) {
+        // The UI as it is now decides who owns the press (a tap earlier in this batch may have opened a
+        // panel that this press hits).
+        ui_pass(v);
         if (rs_ui_captures(v->ui, v->mx, v->my)) {
             v->ui_owns[b] = true;
-            if (b == 0) v->ui_pressed = true;
+            if (b == 0) v->ui_pressed = true, ui_pass(v);
             return;
         }
         v->scene_owns[b] = true;
         if (b == 0) {
-            v->light_drag = glfwGetKey(v->win, GLFW_KEY_L) == GLFW_PRESS;
-            if (!v->light_drag) feed_paint(v, ROUGE_POINTER_DOWN, 0, v->mx, v->my, t);
+            v->light_drag = v->l_held;
+            // Paint mode hands the pointer to the face; view mode orbits here, in window coordinates.
+            v->face_drag = !v->light_drag && v->paint_mode;
+            if (v->face_drag) feed_face(v, ROUGE_POINTER_DOWN, 0, v->wx, v->wy, t);
         }
         return;
     }
     if (v->ui_owns[b]) {
         v->ui_owns[b] = false;
-        if (b == 0) v->ui_released = true;
+        if (b == 0) v->ui_released = true, ui_pass(v);
         return;
     }
     if (!v->scene_owns[b]) return;
     v->scene_owns[b] = false;
-    if (b == 0 && !v->light_drag) feed_paint(v, ROUGE_POINTER_UP, 0, v->mx, v->my, t);
-    v->light_drag = false;
+    if (b == 0 && v->face_drag) feed_face(v, ROUGE_POINTER_UP, 0, v->wx, v->wy, t);
+    if (b == 0) v->light_drag = v->face_drag = false;
 }
 
-static void pointer_move(vw_viewer *v, float x, float y, double t)
+static void pointer_move(vw_viewer *v, float wx, float wy, double t)
 {
-    float dx = x - v->mx, dy = y - v->my;
-    v->mx = x, v->my = y;
+    float dx = wx - v->wx, dy = wy - v->wy;
+    v->wx = wx, v->wy = wy;
+    v->mx = wx * v->px_per_pt, v->my = wy * v->px_per_pt;
     v->ring_moved = true;
+    if (v->ui_owns[0]) ui_pass(v);
     if (v->scene_owns[0]) {
         if (v->light_drag) {
-            float k = 0.4f / v->px_per_pt;
+            const float k = 0.4f;  // degrees per point
             v->view.key.yaw_deg = RS_CLAMP(v->view.key.yaw_deg + dx * k, -LIGHT_DIAL_DEG, LIGHT_DIAL_DEG);
             v->view.key.pitch_deg = RS_CLAMP(v->view.key.pitch_deg - dy * k, -LIGHT_DIAL_DEG, LIGHT_DIAL_DEG);
             dial_from_light(v);
             v->dirty_view = true;
             mark_input(v);
+        } else if (v->face_drag) {
+            feed_face(v, ROUGE_POINTER_MOVE, 0, wx, wy, t);
         } else {
-            feed_paint(v, ROUGE_POINTER_MOVE, 0, x, y, t);
+            orbit(v, dx, dy);
+            mark_input(v);
         }
     }
     if (v->scene_owns[1] || v->scene_owns[2]) {
@@ -677,24 +713,27 @@ static void pointer_move(vw_viewer *v, float x, float y, double t)
     }
 }
 
-// Routes queued events; stops after a UI tap so each tap is its own UI frame.
+// Routes every queued event in order, UI taps included (each has its own input-only UI pass).
 static void dispatch(vw_viewer *v)
 {
     vw_event ev;
     while (vw_queue_pop(&v->queue, &ev)) {
-        float x = ev.x * v->px_per_pt, y = ev.y * v->px_per_pt;
+        v->events_applied++;
         switch (ev.type) {
-        case VW_MOVE: pointer_move(v, x, y, ev.time_s); break;
+        case VW_MOVE: pointer_move(v, ev.x, ev.y, ev.time_s); break;
         case VW_BUTTON:
-            if (!isnan(ev.x) && (x != v->mx || y != v->my)) pointer_move(v, x, y, ev.time_s);
+            if (!isnan(ev.x) && (ev.x != v->wx || ev.y != v->wy)) pointer_move(v, ev.x, ev.y, ev.time_s);
             pointer_button(v, RS_CLAMP(ev.button, 0, 2), ev.down, ev.time_s);
             break;
         case VW_SCROLL:
             zoom_at(v, powf(ZOOM_STEP, ev.dy), v->mx, v->my);
             mark_input(v);
             break;
-        case VW_KEY: key_action(v, ev.key, ev.mods); break;
-        case VW_TOUCH: feed_paint(v, ev.touch, 100 + ev.id, x, y, ev.time_s); break;
+        case VW_KEY:
+            if (ev.key == GLFW_KEY_L) v->l_held = ev.down;
+            if (ev.down) key_action(v, ev.key, ev.mods);
+            break;
+        case VW_TOUCH: feed_face(v, ev.touch, 100 + ev.id, ev.x, ev.y, ev.time_s); break;
         case VW_CHAR:
             if (!vw_editor_char(v, (unsigned)ev.key)) vw_looks_char(v, (unsigned)ev.key);
             break;
@@ -704,7 +743,6 @@ static void dispatch(vw_viewer *v)
             break;
         }
         }
-        if (v->ui_released) break;
     }
 }
 
@@ -739,8 +777,10 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
     vw_viewer *v = glfwGetWindowUserPointer(w);
-    if (action == GLFW_RELEASE || key == GLFW_KEY_UNKNOWN) return;
-    vw_queue_push(&v->queue, &(vw_event){.type = VW_KEY, .time_s = glfwGetTime(), .key = key, .mods = mods});
+    if (key == GLFW_KEY_UNKNOWN) return;
+    // Releases too: a key held during a drag (L) is known from the queue, never sampled.
+    vw_queue_push(&v->queue, &(vw_event){.type = VW_KEY, .time_s = glfwGetTime(), .key = key, .mods = mods,
+                                         .down = action != GLFW_RELEASE});
 }
 
 static void on_char(GLFWwindow *w, unsigned int codepoint)
@@ -793,8 +833,10 @@ double vw_now(void) { return glfwGetTime(); }
 static bool interacting(const vw_viewer *v)
 {
     // A left button held in paint mode paints (full quality, incremental frames); otherwise it orbits.
-    bool painting = v->scene_owns[0] && v->paint_mode && !v->light_drag;
-    bool held = (v->scene_owns[0] && !painting) || v->scene_owns[1] || v->scene_owns[2] || rs_ui_busy(v->ui);
+    bool painting = v->scene_owns[0] && v->face_drag;
+    // A widget held (the editor's colour square, a slider) changes no view: the picture stays at full
+    // quality; the light dial marks its own input.
+    bool held = (v->scene_owns[0] && !painting) || v->scene_owns[1] || v->scene_owns[2];
     return held || vw_now() - v->last_input_s < SETTLE_S || v->frame_no - v->last_input_frame < SETTLE_FRAMES;
 }
 
@@ -821,6 +863,8 @@ static rs_result render_scene(vw_viewer *v, rs_error *err)
 {
     bool inter = interacting(v);
     vw_rung want = inter ? v->rungs[v->rung] : (vw_rung){v->cli->view.max_splats, 1.0f};
+    // A stroke picks in the pixels of the picture on screen: its resolution holds until the face lets go.
+    if (v->face_pointers > 0 && v->paint_mode && !v->partial) want.scale = v->face_scale;
     bool quality_change = want.max_splats != v->rendered.max_splats || want.scale != v->rendered.scale ||
                           (!inter && !v->rendered_full);
     if (!v->dirty_view && !v->dirty_makeup && !quality_change) return RS_OK;
@@ -843,8 +887,9 @@ static rs_result render_scene(vw_viewer *v, rs_error *err)
     v->info = rouge_face_stats(v->face);
     v->dirty_view = v->dirty_makeup = false;
     v->rendered = want;
-    v->rendered_full = !inter;
+    v->rendered_full = !inter && want.scale == 1.0f;
     v->rendered_this_frame = true;
+    v->scale_lo = RS_MIN(v->scale_lo, want.scale), v->scale_hi = RS_MAX(v->scale_hi, want.scale);
     return r;
 }
 
@@ -863,11 +908,11 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
     case RS_UI_TOOL_DIFFUSE: set_mode(v, ROUGE_MODE_DIFFUSE); break;
     case RS_UI_TOOL_FULL: set_mode(v, ROUGE_MODE_FULL); break;
     case RS_UI_TOOL_PIPELINE: key_action(v, GLFW_KEY_R, 0); break;
-    case RS_UI_TOOL_SPLIT: v->split = !v->split, v->dirty_view = true; break;
+    case RS_UI_TOOL_SPLIT: toggle_split(v); break;
     case RS_UI_TOOL_HUD: v->hud = !v->hud; break;
     case RS_UI_TOOL_SAVE: vw_looks_begin_save(v); break;
     case RS_UI_TOOL_LOAD: vw_looks_open(v); break;
-    case RS_UI_TOOL_SCREENSHOT: v->want_face_shot = true; break;
+    case RS_UI_TOOL_SCREENSHOT: vw_looks_begin_export(v); break;
     case RS_UI_TOOL_HELP: v->help = !v->help; break;
     case RS_UI_TOOL_LIGHT:
         v->light_dial[0] = st->light[0], v->light_dial[1] = st->light[1];
@@ -882,14 +927,39 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
     }
 }
 
+// What the input did so far, for the event script's `state` (tests read it).
+static void write_state(vw_viewer *v, const char *path)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        vw_toast(v, true, "%s: %s", path, strerror(errno));
+        return;
+    }
+    const vw_editor *e = &v->editor;
+    fprintf(f, "frame %lld\nscript_events %lld\nevents_applied %lld\nevents_dropped %d\n", v->frame_no,
+            v->script.pushed, v->events_applied, v->queue.dropped);
+    fprintf(f, "yaw_deg %.4f\npitch_deg %.4f\nzoom %.4f\nlight_dial %.4f %.4f\n", v->view.yaw_deg, v->view.pitch_deg,
+            v->view.zoom, v->light_dial[0], v->light_dial[1]);
+    fprintf(f, "editor_open %d\neditor_hsv %.3f %.4f %.4f\neditor_rgb %d %d %d\n", e->open, e->hsv[0], e->hsv[1],
+            e->hsv[2], e->product.rgb[0], e->product.rgb[1], e->product.rgb[2]);
+    fprintf(f, "render_scale %.3f\nrender_scale_range %.3f %.3f\n", v->render_scale, v->scale_lo, v->scale_hi);
+    fprintf(f, "looks_sheet %d\nsave_dialog %d\nsave_name %s\nsplit %d\nsplit_left %s\ntoast %s\n", v->looks.open,
+            v->looks.saving, v->looks.name, v->split, v->looks.compare[0] ? v->looks.compare : "(bare)", v->toast);
+    fclose(f);
+    v->scale_lo = v->scale_hi = v->render_scale;
+}
+
 // One frame: events, rendering, UI, swap. Returns the frame's wall time in ms.
-static double frame(vw_viewer *v, const char *script_shot, const float *script_rect, rs_error *err)
+static double frame(vw_viewer *v, const vw_script_step *step, rs_error *err)
 {
     double t0 = vw_now();
     v->rendered_this_frame = false;
     update_window_size(v);
-    dispatch(v);
-    if (v->face) {
+    // A face just made: its first picture takes seconds on a slow GPU (600k splats on a software
+    // rasteriser: ~3 s), so this frame only says so and the next one draws it. Until the face is there
+    // and drawn, input waits in the queue (nothing to act on yet; nothing is lost).
+    if (v->face && !v->drawing_first) {
+        dispatch(v);
         rs_result r = render_scene(v, err);
         if (r) {
             vw_toast(v, true, "%s", err->msg);
@@ -903,20 +973,22 @@ static double frame(vw_viewer *v, const char *script_shot, const float *script_r
     rs_ui_begin(v->scene_ui, v->fb_w, v->fb_h, v->ui_scale, &(rs_ui_input){.x = -1, .y = -1});
     vw_draw_picture(v, v->scene_ui);
     rs_ui_end(v->scene_ui);
-    // S saves the picture at full quality: while it is still refining (or being moved), the shot waits.
-    if (v->want_face_shot && at_full_quality(v)) {
-        char name[64];
-        if (next_screenshot_name(v, name, sizeof name)) vw_write_png(v, name, NULL, false);
-        v->want_face_shot = false;
-    }
+    // S exports the current look at full quality: while the picture is still refining (or being moved),
+    // the export waits.
+    if (v->looks.export_pending && at_full_quality(v)) vw_looks_export(v);
     rs_ui_toolbar_state st;
     int sw = -1;
     rs_ui_tool t = vw_draw_ui(v, &st, &sw);
     rs_ui_end(v->ui);
     apply_tool(v, t, &st, sw);
-    if (script_shot) vw_write_png(v, script_shot, script_rect, true);
+    if (step && step->screenshot) vw_write_png(v, step->screenshot, step->rect);
+    if (step && step->state) write_state(v, step->state);
     glfwSwapBuffers(v->win);
+    v->drawing_first = false;
     v->frame_no++;
+    // The script's `slow`: a slow device, to prove that input keeps arriving whole meanwhile.
+    double slow_s = v->have_script ? v->script.slow_s : 0, left_s = t0 + slow_s - vw_now();
+    if (left_s > 0) nanosleep(&(struct timespec){(time_t)left_s, (long)(fmod(left_s, 1.0) * 1e9)}, NULL);
     double ms = (vw_now() - t0) * 1000.0;
     if (v->rendered_this_frame) {
         v->frame_ms_avg = v->frame_ms_avg > 0 ? v->frame_ms_avg * 0.8 + ms * 0.2 : ms;
@@ -944,12 +1016,23 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
             vw_apply_brush(v);
         }
     }
-    if (!load_finished(v)) return RS_OK;
+    if (!l->building) {
+        if (!load_finished(v)) return RS_OK;
+        // Every splat is decoded; making the face of them blocks this thread for a while. One frame first
+        // says so (the loading line once sat at "N of N splats" all that time).
+        if (!l->result && (!l->shown || v->partial)) {
+            l->building = true;
+            l->decoded_s = now - l->t0;
+            return RS_OK;
+        }
+    }
+    l->building = false;
     bool was_partial = v->partial;
     rs_error e = {0};
     rs_result r = (rs_result)l->result;
     if (r) rs_fail(&e, r, "%s", l->err.msg);
     else if (!l->shown || was_partial) r = face_open(v, &e);
+    v->drawing_first = !r && (!l->shown || was_partial);
     rouge_stream_destroy(l->stream);
     l->stream = NULL;
     v->partial = false;  // on failure a preview stays: all there is of that file
@@ -976,8 +1059,8 @@ static bool at_full_quality(const vw_viewer *v)
            !v->dirty_makeup && v->queue.count == 0;
 }
 
-// ... and no screenshot is waiting for it (scripts' `idle` and `quit` wait for S too).
-static bool settled(const vw_viewer *v) { return at_full_quality(v) && !v->want_face_shot; }
+// ... and no export is waiting for it (scripts' `idle` and `quit` wait for S too).
+static bool settled(const vw_viewer *v) { return at_full_quality(v) && !v->looks.export_pending; }
 
 static int cmp_double(const void *a, const void *b)
 {
@@ -998,9 +1081,9 @@ static rs_result bench_orbit(vw_viewer *v, int n, rs_error *err)
     glfwSwapInterval(0);
     // Warm up: one full frame, and let the controller settle on its LOD over a few frames.
     for (int i = 0; i < n + 10 && !glfwWindowShouldClose(v->win); i++) {
-        orbit(v, 6.0f * v->px_per_pt, 0);
+        orbit(v, 6.0f, 0);
         mark_input(v);
-        double t = frame(v, NULL, NULL, err);
+        double t = frame(v, NULL, err);
         if (i >= 10) ms[i - 10] = t, splats[i - 10] = rouge_face_stats(v->face).splats_drawn;
     }
     qsort(ms, (size_t)n, sizeof *ms, cmp_double);
@@ -1033,20 +1116,19 @@ static rs_result run(vw_viewer *v, rs_error *err)
             return RS_OK;
         }
         glfwPollEvents();
-        v->queue.count = 0;  // input during loading is dropped (nothing to act on)
         if ((r = poll_loader(v, err))) return r;
         if (!v->face || v->load.running) {
-            frame(v, NULL, NULL, err);
+            frame(v, NULL, err);
             glfwWaitEventsTimeout(0.03);
         }
     }
     // One frame with the toolbar before any input: presses are routed by what the last frame drew.
-    frame(v, NULL, NULL, err);
+    frame(v, NULL, err);
     if (o.bench_orbit > 0) return bench_orbit(v, o.bench_orbit, err);
 
     while (!v->quit && !glfwWindowShouldClose(v->win)) {
         // Sleep while nothing changes: a viewer at rest costs no CPU.
-        bool busy = v->load.running || interacting(v) || v->dirty_view || v->dirty_makeup || !v->rendered_full ||
+        bool busy = v->load.running || v->load.building || interacting(v) || v->dirty_view || v->dirty_makeup || !v->rendered_full ||
                     (v->toast[0] && vw_now() < v->toast_until + 0.1);
         if (busy) glfwPollEvents();
         else glfwWaitEventsTimeout(v->have_script ? 0.01 : 0.5);
@@ -1057,7 +1139,7 @@ static rs_result run(vw_viewer *v, rs_error *err)
             if (step.quit) v->quit = true;
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
         }
-        frame(v, step.screenshot, step.rect, err);
+        frame(v, &step, err);
     }
     return RS_OK;
 }
@@ -1106,7 +1188,9 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         double mx, my;
         glfwGetCursorPos(v->win, &mx, &my);
         update_window_size(v);
-        v->mx = (float)mx * v->px_per_pt, v->my = (float)my * v->px_per_pt;
+        v->wx = (float)mx, v->wy = (float)my;
+        v->mx = v->wx * v->px_per_pt, v->my = v->wy * v->px_per_pt;
+        v->scale_lo = v->scale_hi = 1;
         r = run(v, err);
     }
     if (v->face && cli->record) {

@@ -38,13 +38,14 @@ void vw_draw_picture(vw_viewer *v, rs_ui *ui)
     }
 }
 
-// The before/after divider: a line with a round handle just above the swatch sheet (on the picture's
-// bottom edge, clear of the lips and eyes at any zoom; at 72 % of the height it once sat on the lips),
-// "Before" and "After" (or the compared look's name and "Current") on either side of the handle.
+// The before/after divider: a line with a round handle on the picture's bottom edge, just above the
+// swatch sheet, and "Before" and "After" (or the compared look's name and "Current") in the bottom
+// corners: all of it clear of the face's centre, where finishes are compared (beside the handle the
+// labels once sat on the lips).
 static void draw_split_divider(vw_viewer *v, const rs_ui_toolbar_layout *l)
 {
     float s = v->ui_scale, sx = floorf(v->split_frac * (float)v->fb_w), hr = 22 * s;
-    float hy = floorf(l->bottom.y - hr - 14 * s);
+    float hy = floorf(l->bottom.y - hr - 4 * s);
     rs_ui_line(v->ui, sx, 0, sx, (float)v->fb_h, 2.5f * s, (rs_ui_rgba){255, 255, 255, 220});
     float dx, dy;
     // The whole line is draggable, the handle just shows where.
@@ -60,9 +61,9 @@ static void draw_split_divider(vw_viewer *v, const rs_ui_toolbar_layout *l)
     bool cmp = vw_looks_comparing(v);
     const char *left = cmp ? v->looks.compare : "Before", *right = cmp ? "Current" : "After";
     float lw = rs_ui_text_width(left, ts), rw = rs_ui_text_width(right, ts), th = 7.0f * (float)ts;
-    float ph = th + 14 * s, py = hy - ph * 0.5f;
-    rs_ui_rect lr = {sx - hr - 10 * s - lw - 20 * s, py, lw + 20 * s, ph};
-    rs_ui_rect rr = {sx + hr + 10 * s, py, rw + 20 * s, ph};
+    float ph = th + 14 * s, py = l->bottom.y - ph - 6 * s;
+    rs_ui_rect lr = {l->left.x + l->left.w + 8 * s, py, lw + 20 * s, ph};
+    rs_ui_rect rr = {l->right.x - 8 * s - rw - 20 * s, py, rw + 20 * s, ph};
     rs_ui_fill(v->ui, lr, ph * 0.5f, RS_UI_PANEL);
     rs_ui_text(v->ui, lr.x + 10 * s, py + (ph - th) * 0.5f, ts, RS_UI_WHITE, left);
     rs_ui_fill(v->ui, rr, ph * 0.5f, RS_UI_PANEL);
@@ -72,7 +73,7 @@ static void draw_split_divider(vw_viewer *v, const rs_ui_toolbar_layout *l)
 // The brush ring: the brush's footprint on the face under the cursor (its size at that depth).
 static void draw_brush_ring(vw_viewer *v)
 {
-    if (!v->paint_mode || !v->face || v->pointer_outside || v->scene_owns[1] || v->scene_owns[2] ||
+    if (v->ui_input_only || !v->paint_mode || !v->face || v->pointer_outside || v->scene_owns[1] || v->scene_owns[2] ||
         rs_ui_captures(v->ui, v->mx, v->my))
         return;
     if (v->ring_moved && !v->scene_owns[0]) {
@@ -187,7 +188,15 @@ static void draw_loading(vw_viewer *v)
     const char *base = strrchr(v->load.path, '/');
     rouge_stream_progress p = v->load.stream ? rouge_stream_get_progress(v->load.stream) : (rouge_stream_progress){0};
     uint32_t decoded = p.decoded, count = p.splats;
-    if (count)
+    // The stages after decoding, as they happen: making the face (GPU upload, shaders), then its first
+    // picture (seconds for a large face on a slow GPU).
+    if (v->drawing_first)
+        snprintf(line, sizeof line, "Loading %s: %u splats; drawing the first picture", base ? base + 1 : v->load.path,
+                 v->info.splats);
+    else if (v->load.building)
+        snprintf(line, sizeof line, "Loading %s: %u splats decoded in %.1f s; building the face (GPU upload, shaders)",
+                 base ? base + 1 : v->load.path, count, v->load.decoded_s);
+    else if (count)
         snprintf(line, sizeof line, "Loading %s  %.1f s  %u of %u splats", base ? base + 1 : v->load.path, t, decoded,
                  count);
     else
@@ -227,7 +236,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         draw_loading(v);
         return RS_UI_TOOL_NONE;
     }
-    if (v->load.running) draw_loading(v);
+    if (v->load.running || v->load.building || v->drawing_first) draw_loading(v);
     // The look library's sheet and dialog are modal: the toolbar steps aside while they are up.
     if (vw_looks_modal(v)) {
         *st = (rs_ui_toolbar_state){0};
@@ -286,7 +295,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
 }
 
 // Writes the bound framebuffer (or the region rect, window coordinates, when given) as an RGB PNG.
-void vw_write_png(vw_viewer *v, const char *path, const float *rect, bool quiet)
+void vw_write_png(vw_viewer *v, const char *path, const float *rect)
 {
     rs_image img = {0};
     rs_error err = {0};
@@ -311,5 +320,4 @@ void vw_write_png(vw_viewer *v, const char *path, const float *rect, bool quiet)
     }
     rs_image_free(&img);
     if (r) vw_toast(v, true, "%s", err.msg);
-    else if (!quiet) vw_toast(v, false, "Screenshot %s", path);
 }

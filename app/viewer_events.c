@@ -190,12 +190,16 @@ static rs_result parse_line(parser *p, char **tok, int n)
         if (n != 2 || !rs_parse_number(tok[1], -100, 100, &a[0])) return BAD("expected DY (-100..100)");
         return add_event(p, (vw_event){.type = VW_SCROLL, .dy = (float)a[0]}, true);
     }
-    if (!strcmp(c, "key")) {
+    if (!strcmp(c, "key") || !strcmp(c, "keydown") || !strcmp(c, "keyup")) {
         int key, mods;
         if (n != 2) return BAD("expected one key name");
         if (!vw_key_from_name(tok[1], &key, &mods))
-            return rs_fail(err, RS_ERR_FORMAT, "%s:%d: key: unknown key '%s'", p->file, p->line, tok[1]);
-        return add_event(p, (vw_event){.type = VW_KEY, .key = key, .mods = mods}, true);
+            return rs_fail(err, RS_ERR_FORMAT, "%s:%d: %s: unknown key '%s'", p->file, p->line, c, tok[1]);
+        vw_event ev = {.type = VW_KEY, .key = key, .mods = mods, .down = true};
+        rs_result r = c[3] == 'u' ? RS_OK : add_event(p, ev, true);
+        ev.down = false;
+        if (!r && c[3] != 'd') r = add_event(p, ev, c[3] == 'u');
+        return r;
     }
     if (!strcmp(c, "type")) {
         // The rest of the line (words joined by single spaces), one character event each.
@@ -229,6 +233,17 @@ static rs_result parse_line(parser *p, char **tok, int n)
         snprintf(cmd.path, sizeof cmd.path, "%s", tok[1]);
         for (int i = 0; i < 4; i++) cmd.rect[i] = (float)a[i];
         return add(p, &cmd);
+    }
+    if (!strcmp(c, "state")) {
+        if (n != 2) return BAD("expected one file name (no spaces)");
+        vw_cmd cmd = {.type = VW_CMD_STATE};
+        if (strlen(tok[1]) >= sizeof cmd.path) return BAD("file name too long");
+        snprintf(cmd.path, sizeof cmd.path, "%s", tok[1]);
+        return add(p, &cmd);
+    }
+    if (!strcmp(c, "slow")) {
+        if (n != 2 || !rs_parse_number(tok[1], 0, 60, &a[0])) return BAD("expected seconds per frame (0..60)");
+        return add(p, &(vw_cmd){.type = VW_CMD_SLOW, .value = a[0]});
     }
     if (!strcmp(c, "drop") || !strcmp(c, "screenshot") || !strcmp(c, "wait-for")) {
         if (n != 2) return BAD(c[0] == 's' ? "expected FILE [X Y W H]" : "expected one file name (no spaces)");
@@ -319,19 +334,33 @@ void vw_script_run(vw_script *s, vw_queue *q, bool settled, bool loading, double
     s->want_idle = false;
     while (s->next < s->count) {
         const vw_cmd *c = &s->cmd[s->next];
+        if (c->type != VW_CMD_EVENT) s->live_wall_s = -1;  // slow: the next event sets the clocks together
         switch (c->type) {
         case VW_CMD_EVENT: {
             if (q->count >= VW_QUEUE_CAP - 1) return;  // let the frame drain the queue first
+            double t = s->clock_s + (c->advance ? s->step_s : 0);
+            if (s->slow_s > 0) {
+                if (s->live_wall_s < 0) s->live_wall_s = now_s, s->live_clock_s = s->clock_s;
+                if (now_s < s->live_wall_s + (t - s->live_clock_s)) return;  // it has not happened yet
+            }
             vw_event ev = c->ev;
-            if (c->advance) s->clock_s += s->step_s;
-            ev.time_s = s->clock_s;
+            s->clock_s = ev.time_s = t;
             vw_queue_push(q, &ev);
+            s->pushed++;
             s->next++;
-            // A button press or release ends the frame's batch, as it would for a hand: the UI decides who
-            // owns a press from what the last frame drew (a click may open what the next click hits).
-            if (ev.type == VW_BUTTON) return;
+            // Normally a button press or release ends the frame's batch (one step at a time, as a fast
+            // machine sees a hand); under `slow` every event whose time has come goes into this frame.
+            if (ev.type == VW_BUTTON && s->slow_s <= 0) return;
             break;
         }
+        case VW_CMD_SLOW:
+            s->slow_s = c->value;
+            s->next++;
+            break;
+        case VW_CMD_STATE:
+            out->state = c->path;
+            s->next++;
+            return;
         case VW_CMD_STEP:
             s->step_s = c->value;
             s->next++;

@@ -29,7 +29,7 @@ typedef enum vw_event_type {
     VW_MOVE = 0,   // pointer (mouse) moved to x, y
     VW_BUTTON,     // mouse button `button` (0 left, 1 right, 2 middle) down/up at x, y
     VW_SCROLL,     // wheel by dy (+ = away from the user = zoom in)
-    VW_KEY,        // key press: GLFW key code + GLFW modifier bits
+    VW_KEY,        // key press (down) or release: GLFW key code + GLFW modifier bits
     VW_TOUCH,      // touch pointer `id` down/move/up at x, y
     VW_DROP,       // a file dropped on the window
     VW_CHAR,       // a character typed (Unicode code point in `key`): text fields
@@ -69,9 +69,10 @@ bool vw_queue_peek(const vw_queue *q, vw_event *ev);
 //   click X Y                   move, down, up (left)
 //   drag X0 Y0 X1 Y1 [STEPS] [left|right|middle]   press, STEPS moves (default 20), release
 //   scroll DY                   mouse wheel (+ zooms in)
-//   key NAME                    a key press: a character (p, [, ?, ...) or f1..f12, esc, tab, space,
-//                               enter, left, right, up, down, delete, backspace, home; prefixes ctrl+,
-//                               shift+, alt+ (ctrl+z, shift+[)
+//   key NAME                    a key pressed and released: a character (p, [, ?, ...) or f1..f12, esc,
+//                               tab, space, enter, left, right, up, down, delete, backspace, home;
+//                               prefixes ctrl+, shift+, alt+ (ctrl+z, shift+[)
+//   keydown NAME, keyup NAME    a key held / let go (L held while dragging moves the light)
 //   touch ID down|move|up X Y   touch pointer ID (1..9): two of them pinch and pan
 //   type TEXT                   characters typed (a text field: the look library's save dialog)
 //   drop FILE                   as if FILE was dropped on the window
@@ -85,6 +86,11 @@ bool vw_queue_peek(const vw_queue *q, vw_event *ev);
 //                               from outside, e.g. xdotool)
 //   loaded                      keep running until the face file has loaded completely (a preview of
 //                               its first LOD levels may be on screen before)
+//   slow S                      from here every frame takes at least S seconds (a slow device) and
+//                               events arrive by the script clock in real time, as a hand's do: one
+//                               frame gets every event that happened during it; 0 = back to normal
+//   state FILE                  write what the input did so far (camera, light, editor colour, events
+//                               queued and applied, render scales) as "name value" lines
 //   quit                        close the viewer (exit status 0)
 
 typedef enum vw_cmd_type {
@@ -96,6 +102,8 @@ typedef enum vw_cmd_type {
     VW_CMD_SCREENSHOT,
     VW_CMD_WAIT_FOR,
     VW_CMD_LOADED,
+    VW_CMD_SLOW,
+    VW_CMD_STATE,
     VW_CMD_QUIT,
 } vw_cmd_type;
 
@@ -105,7 +113,7 @@ typedef struct vw_cmd {
     bool advance;       // pointer events advance the script clock by one step
     double value;       // step/wait seconds, frame count
     int line;
-    char path[512];     // screenshot, wait-for
+    char path[512];     // screenshot, wait-for, state
     float rect[4];      // screenshot region X Y W H (window coordinates); W = 0: the whole window
 } vw_cmd;
 
@@ -120,6 +128,9 @@ typedef struct vw_script {
     bool want_idle;
     bool want_shot;
     bool done;
+    // `slow`: the frame's minimum duration, and where the script clock met the wall clock.
+    double slow_s, live_wall_s, live_clock_s;
+    long long pushed;   // events queued by the script so far
 } vw_script;
 
 #define VW_SCRIPT_MAX_BYTES (4u << 20)
@@ -134,6 +145,7 @@ typedef struct vw_script_step {
     bool quit;
     const char *screenshot;  // write the window to this path at the end of this frame
     const float *rect;       // ... this region of it (window coordinates), or all of it when rect[2] == 0
+    const char *state;       // write the viewer's state to this path at the end of this frame
 } vw_script_step;
 
 // Runs commands until one blocks: pushes events into q. `settled` says the picture is at full quality
@@ -160,6 +172,8 @@ typedef struct vw_loader {
     rouge_error err;
     double t0, last_preview;
     uint32_t shown;               // splats of the face on screen made from the stream (0: none)
+    bool building;                // read and decoded: the face is made of it next frame (the screen says so)
+    double decoded_s;             // ... how long reading and decoding took
 } vw_loader;
 
 // The look library (viewer_looks.c).
@@ -180,6 +194,9 @@ typedef struct vw_looks {
     bool clash;                 // the dialog's name is taken: it asks before overwriting
     bool back_to_sheet;         // the dialog was opened from the sheet (and returns there)
     char name[RS_LOOKLIB_NAME_MAX + 1];  // the name being typed
+    bool exporting;             // the dialog asks where to export the picture (S) instead
+    char export_path[1024];     // ... the path being typed (prefilled with a free name)
+    bool export_pending;        // export_path is written once the picture is at full quality
     rs_looklib_entry *entries;  // newest first
     uint32_t count;
     int page, selected, per_page, cols;
@@ -228,6 +245,7 @@ typedef struct vw_viewer {
     char face_path[512];
     vw_loader load;
     bool partial;  // the face shown is a preview of a file still loading: painting waits for the rest
+    bool drawing_first;  // the whole face was just made: this frame says its first picture comes next
 
     // Window (screen coordinates) and framebuffer (pixels).
     int win_w, win_h, fb_w, fb_h;
@@ -250,11 +268,20 @@ typedef struct vw_viewer {
     bool eraser, mirror;
     bool any_region;  // K: paint anywhere instead of keeping to the product's region
 
-    // Pointer.
+    // Pointer. Gestures are measured in window coordinates (wx, wy: the events' own), so a render scale
+    // that changes mid-drag cannot change what the drag means; mx, my are the same point for the UI.
+    float wx, wy;               // window coordinates
     float mx, my;               // framebuffer pixels
+    bool l_held;                // L is down (from the queued key events, never sampled)
+    int face_pointers;          // pointers the face holds down (painting, touch gestures)
+    float face_scale;           // render pixels per framebuffer pixel the face's gesture is measured in
+    bool ui_input_only;         // an input-only UI pass (rs_ui_end_input): draw nothing costly
+    long long events_applied;   // events taken from the queue and routed (the `state` script command)
+    float scale_lo, scale_hi;   // render scales drawn since the last `state`
     bool ui_owns[3];            // a press of button b went to the UI
     bool scene_owns[3];         // ... or to the scene
     bool light_drag;            // L held at press: the left drag moves the light
+    bool face_drag;             // ... else in paint mode it went to the face; else it orbits
     bool ui_pressed, ui_released;
     bool ring_valid;
     float ring_px;              // brush ring radius on screen
@@ -278,7 +305,6 @@ typedef struct vw_viewer {
     // Files.
     vw_looks looks;
     vw_editor editor;
-    int shot_counter;
     char toast[256];
     bool toast_error;
     double toast_until;
@@ -286,7 +312,6 @@ typedef struct vw_viewer {
     char swatch_names[RS_UI_TOOLBAR_MAX_SWATCHES][RS_COSMETIC_NAME_MAX];
     const char *swatch_name_ptr[RS_UI_TOOLBAR_MAX_SWATCHES];
     char size_text[24], opacity_text[24];  // the sliders' values as shown ("18 mm", "80%")
-    bool want_face_shot;        // the screenshot action: taken once the picture is drawn, before the UI
     bool quit;
 } vw_viewer;
 
@@ -318,6 +343,11 @@ void vw_looks_init(vw_viewer *v);
 void vw_looks_free(vw_viewer *v);
 void vw_looks_open(vw_viewer *v);           // Ctrl+O, the top bar's folder
 void vw_looks_begin_save(vw_viewer *v);     // Ctrl+S, the top bar's save
+void vw_looks_begin_export(vw_viewer *v);   // S, the top bar's camera: asks where, prefilled
+// Writes the face's last frame (the current look, full quality, no UI or split) to export_path and the
+// look beside it (.look); says where in a toast.
+void vw_looks_export(vw_viewer *v);
+void vw_looks_compare_bare(vw_viewer *v);   // the split's left half shows the bare face
 bool vw_looks_modal(const vw_viewer *v);    // the sheet or the dialog is up: the toolbar steps aside
 bool vw_looks_key(vw_viewer *v, int key, int mods);  // true when the sheet/dialog took the key
 void vw_looks_char(vw_viewer *v, unsigned codepoint);
@@ -344,6 +374,6 @@ void vw_draw_picture(vw_viewer *v, rs_ui *ui);
 // none) with the toolbar state after the frame's input in *st and the swatch in *swatch.
 rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch);
 // Writes the bound framebuffer (or a region, window coordinates, when rect[2] > 0) as an RGB PNG.
-void vw_write_png(vw_viewer *v, const char *path, const float *rect, bool quiet);
+void vw_write_png(vw_viewer *v, const char *path, const float *rect);
 
 #endif

@@ -11,6 +11,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #define ID_BASE 5000  // widget ids of the sheet and dialog: 5000 + ...
 
@@ -130,8 +132,83 @@ void vw_looks_begin_save(vw_viewer *v)
 static void end_save(vw_viewer *v)
 {
     vw_looks *L = &v->looks;
-    L->saving = L->clash = false;
+    L->saving = L->clash = L->exporting = false;
     if (L->back_to_sheet) vw_looks_open(v);
+}
+
+// --- export (S): the picture and its look, where the person says ----------------------------------------
+
+// The export as typed, ending in .png (added when missing), and its look beside it (.look).
+static void export_paths(const char *typed, char *png, size_t png_n, char *look, size_t look_n)
+{
+    size_t n = strlen(typed);
+    bool ext = n >= 4 && !strcmp(typed + n - 4, ".png");
+    snprintf(png, png_n, "%s%s", typed, ext ? "" : ".png");
+    snprintf(look, look_n, "%.*s.look", (int)(ext ? n - 4 : n), typed);
+}
+
+// The folder of `path` exists (the export can be written there).
+static bool export_dir_ok(const char *path)
+{
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (!slash) return true;
+    if (slash == dir) slash[1] = 0;
+    else *slash = 0;
+    struct stat st;
+    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+void vw_looks_begin_export(vw_viewer *v)
+{
+    vw_looks *L = &v->looks;
+    // Prefilled with a free name where the last export went, else in the working directory, as an
+    // absolute path: the person sees where before saying yes, and can type another.
+    char dir[1024] = ".";
+    if (L->export_path[0] && strrchr(L->export_path, '/')) {
+        snprintf(dir, sizeof dir, "%s", L->export_path);
+        *strrchr(dir, '/') = 0;
+    } else if (!getcwd(dir, sizeof dir)) {
+        snprintf(dir, sizeof dir, ".");
+    }
+    char png[1100], look[1100];
+    for (int i = 1; i < 10000; i++) {
+        snprintf(L->export_path, sizeof L->export_path, "%s/rouge-%04d.png", dir, i);
+        export_paths(L->export_path, png, sizeof png, look, sizeof look);
+        if (access(png, F_OK) != 0 && access(look, F_OK) != 0) break;
+    }
+    L->back_to_sheet = L->open;
+    L->open = false;
+    L->saving = L->exporting = true;
+    L->clash = false;
+}
+
+// Enter or Export: the dialog closes at once; the file is written when the picture is at full quality.
+static void accept_export(vw_viewer *v)
+{
+    vw_looks *L = &v->looks;
+    char png[1100], look[1100];
+    export_paths(L->export_path, png, sizeof png, look, sizeof look);
+    snprintf(L->export_path, sizeof L->export_path, "%s", png);
+    L->export_pending = true;
+    end_save(v);
+}
+
+void vw_looks_export(vw_viewer *v)
+{
+    vw_looks *L = &v->looks;
+    L->export_pending = false;
+    char png[1100], look[1100];
+    export_paths(L->export_path, png, sizeof png, look, sizeof look);
+    rouge_error e = {0};
+    // The face's own last frame: the current look at full quality, without the split or the UI.
+    if (rouge_face_write_png(v->face, png, &e) != ROUGE_OK || rouge_face_save_look(v->face, look, &e) != ROUGE_OK) {
+        vw_toast(v, true, "%s", e.msg);
+        return;
+    }
+    const char *base = strrchr(look, '/');
+    vw_toast(v, false, "Exported %s (look: %s)", png, base ? base + 1 : look);
 }
 
 // The thumbnail: the face with this look, frontal, framed brows to chin (rs_app_thumbnail_view, as
@@ -219,8 +296,7 @@ static void compare(vw_viewer *v, int i)
     vw_looks *L = &v->looks;
     rs_error err = {0};
     if (i < 0) {
-        L->compare[0] = 0;
-        rouge_face_set_compare_look(v->face, NULL, NULL);
+        vw_looks_compare_bare(v);
     } else {
         char path[1100];
         rs_result r = rs_looklib_path(L->dir, L->entries[i].name, false, path, sizeof path, &err);
@@ -261,6 +337,13 @@ static void delete_at(vw_viewer *v, int i)
     refresh(v);
 }
 
+void vw_looks_compare_bare(vw_viewer *v)
+{
+    v->looks.compare[0] = 0;
+    v->looks.compare_dirty = true;
+    if (v->face) rouge_face_set_compare_look(v->face, NULL, NULL);
+}
+
 void vw_looks_forget_face(vw_viewer *v)
 {
     // Another face: the compared look was loaded into the old one.
@@ -272,6 +355,13 @@ void vw_looks_forget_face(vw_viewer *v)
 bool vw_looks_key(vw_viewer *v, int key, int mods)
 {
     vw_looks *L = &v->looks;
+    if (L->exporting) {
+        size_t n = strlen(L->export_path);
+        if (key == GLFW_KEY_ESCAPE) end_save(v);
+        else if (key == GLFW_KEY_BACKSPACE && n) L->export_path[n - 1] = 0, L->clash = false;
+        else if ((key == GLFW_KEY_ENTER || key == GLFW_KEY_KP_ENTER) && !L->clash && n) accept_export(v);
+        return true;
+    }
     if (L->saving) {
         // The dialog owns the keyboard: letters arrive as characters (vw_looks_char).
         size_t n = strlen(L->name);
@@ -303,6 +393,13 @@ bool vw_looks_key(vw_viewer *v, int key, int mods)
 void vw_looks_char(vw_viewer *v, unsigned codepoint)
 {
     vw_looks *L = &v->looks;
+    if (L->exporting) {
+        // A path: any printable character.
+        size_t n = strlen(L->export_path);
+        if (codepoint >= 32 && codepoint < 127 && n + 1 < sizeof L->export_path)
+            L->export_path[n] = (char)codepoint, L->export_path[n + 1] = 0, L->clash = false;
+        return;
+    }
     if (!L->saving) return;
     size_t n = strlen(L->name);
     char c = codepoint < 128 ? (char)codepoint : 0;
@@ -439,31 +536,45 @@ static void draw_dialog(vw_viewer *v, const vw_looks_sheet_layout *l)
     rs_ui_panel(ui, d, 18 * s);
     rs_ui_fill(ui, d, 18 * s, (rs_ui_rgba){22, 22, 27, 220});
     rs_ui_rect in = rs_ui_rect_inset(d, 16 * s);
-    rs_ui_text(ui, in.x, in.y + 6 * s, ts, RS_UI_ACCENT, "Save look as");
-    // The name field, with a caret blinking at its end.
+    rs_ui_text(ui, in.x, in.y + 6 * s, ts, RS_UI_ACCENT, L->exporting ? "Export picture as" : "Save look as");
+    // What is typed, and said while typing: a name or file in use turns Save into Overwrite (Enter never
+    // overwrites).
+    char note[1300], shown[1100];
+    rs_ui_rgba note_c = RS_UI_DIM, bad_c = {255, 130, 140, 255};
+    bool valid;
+    if (L->exporting) {
+        char png[1100], look[1100];
+        export_paths(L->export_path, png, sizeof png, look, sizeof look);
+        valid = L->export_path[0] && export_dir_ok(png);
+        L->clash = valid && access(png, F_OK) == 0;
+        const char *base = strrchr(look, '/');
+        if (L->clash) snprintf(note, sizeof note, "That file exists: Overwrite replaces it"), note_c = bad_c;
+        else if (!valid) snprintf(note, sizeof note, "No such folder"), note_c = bad_c;
+        else snprintf(note, sizeof note, "The current look at full quality; its look beside it: %s", base ? base + 1 : look);
+        // A long path shows its end (the file name), where typing happens.
+        size_t fit = (size_t)RS_MAX(8.0f, (l->field.w - 30 * s) / (float)(RS_UI_FONT_CELL_W * ts)), n = strlen(L->export_path);
+        snprintf(shown, sizeof shown, "%s%s", n > fit ? "..." : "", L->export_path + (n > fit ? n - fit + 3 : 0));
+    } else {
+        rs_error err = {0};
+        valid = rs_looklib_check_name(L->name, &err) == RS_OK;
+        L->clash = valid && L->dir[0] && rs_looklib_exists(L->dir, L->name);
+        if (L->clash) snprintf(note, sizeof note, "'%s' is already in the library: Overwrite replaces it", L->name), note_c = bad_c;
+        else if (!valid) snprintf(note, sizeof note, "%s", err.msg), note_c = bad_c;
+        else snprintf(note, sizeof note, "Letters, digits, space, - and _ (up to %d)", RS_LOOKLIB_NAME_MAX);
+        snprintf(shown, sizeof shown, "%s", L->name);
+    }
+    // The field, with a caret blinking at its end.
     rs_ui_fill(ui, l->field, 10 * s, (rs_ui_rgba){8, 8, 10, 255});
     rs_ui_stroke(ui, l->field, 10 * s, 1.5f * s, L->clash ? (rs_ui_rgba){230, 80, 95, 255} : RS_UI_ACCENT);
     float tx = l->field.x + 12 * s, ty = l->field.y + (l->field.h - 7.0f * (float)ts) * 0.5f;
-    float w = rs_ui_text(ui, tx, ty, ts, RS_UI_WHITE, L->name);
+    float w = rs_ui_text(ui, tx, ty, ts, RS_UI_WHITE, shown);
     if (fmod(vw_now(), 1.0) < 0.6) rs_ui_fill(ui, (rs_ui_rect){tx + w + 3 * s, ty - 2 * s, 2 * s, 11.0f * (float)ts}, 0, RS_UI_WHITE);
-    rs_error err = {0};
-    bool valid = rs_looklib_check_name(L->name, &err) == RS_OK;
-    // Said while typing: a name in use turns Save into Overwrite (Enter never overwrites).
-    L->clash = valid && L->dir[0] && rs_looklib_exists(L->dir, L->name);
-    char note[200];
-    rs_ui_rgba note_c = RS_UI_DIM;
-    if (L->clash) {
-        snprintf(note, sizeof note, "'%s' is already in the library: Overwrite replaces it", L->name);
-        note_c = (rs_ui_rgba){255, 130, 140, 255};
-    } else if (!valid) {
-        snprintf(note, sizeof note, "%s", err.msg);
-        note_c = (rs_ui_rgba){255, 130, 140, 255};
-    } else {
-        snprintf(note, sizeof note, "Letters, digits, space, - and _ (up to %d)", RS_LOOKLIB_NAME_MAX);
-    }
     rs_ui_text(ui, l->field.x, l->field.y + l->field.h + 10 * s, ts_small, note_c, note);
-    const char *ok = L->clash ? "Overwrite" : "Save";
-    if (rs_ui_text_button(ui, ID_BASE + 20, l->ok, ok, valid) && valid) save(v, L->clash);
+    const char *ok = L->clash ? "Overwrite" : L->exporting ? "Export" : "Save";
+    if (rs_ui_text_button(ui, ID_BASE + 20, l->ok, ok, valid) && valid) {
+        if (L->exporting) accept_export(v);
+        else save(v, L->clash);
+    }
     if (L->saving && rs_ui_text_button(ui, ID_BASE + 21, l->cancel, "Cancel", false)) end_save(v);
 }
 
