@@ -52,7 +52,7 @@ SOMAJOR  := 0
 SONAME   := librouge.so.$(SOMAJOR)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 
-.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall import-fixtures
+.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall import-fixtures web web-deps
 all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES)
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
@@ -134,6 +134,93 @@ $(BUILD)/rouge-env: $(ENV_TOOL_OBJ) $(BUILD)/librouge.a
 $(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a
 	$(CC) $(CFLAGS) $< $(LIBS) $(LDFLAGS) -o $@
 
+# ---- the web build (make web): the same library compiled to WebAssembly by Debian's emscripten ----
+# build/web/ is a static site: index.html (the viewer page), rouge.js (the ES-module JS API), rouge_core.js +
+# rouge_core.wasm (the library + web/rouge_web.c), the bundled face and environments. zlib, libpng and zstd
+# are compiled from Debian's source packages (make web-deps fetches them; see tools/web_deps.sh). emcc's JS
+# optimiser needs Debian's node modules (acorn) on NODE_PATH when node is not Debian's own.
+EMCC      ?= emcc
+WEB       := $(BUILD)/web
+WEB_DEPS  := $(BUILD)/web-deps/src
+WEB_OBJ   := $(BUILD)/web-obj
+# clang (emcc) has no -Wno-format-truncation; the library's own warnings stay errors.
+WEB_CFLAGS := -std=c11 -O3 -Wall -Wextra -Werror -Iinclude -Isrc -I$(WEB_OBJ)/include
+WEB_3P_CFLAGS := -O3 -w -DNDEBUG -I$(WEB_OBJ)/include
+WEB_ZLIB  := adler32 crc32 deflate inffast inflate inftrees trees zutil compress uncompr
+WEB_PNG   := png pngerror pngget pngmem pngread pngrio pngrtran pngrutil pngset pngtrans pngwio pngwrite pngwtran pngwutil
+WEB_3P_OBJ = $(WEB_ZLIB:%=$(WEB_OBJ)/zlib/%.o) $(WEB_PNG:%=$(WEB_OBJ)/png/%.o) \
+             $(patsubst $(WEB_DEPS)/libzstd/lib/%.c,$(WEB_OBJ)/zstd/%.o,$(wildcard $(WEB_DEPS)/libzstd/lib/common/*.c \
+               $(WEB_DEPS)/libzstd/lib/compress/*.c $(WEB_DEPS)/libzstd/lib/decompress/*.c))
+WEB_LIB_OBJ := $(LIB_SRC:%.c=$(WEB_OBJ)/%.o) $(WEB_OBJ)/gen/shaders.o $(WEB_OBJ)/web/rouge_web.o
+WEB_PAGE  := $(wildcard web/*.html web/*.js web/*.css)
+PAREN     := (
+WEB_EXPORTS := $(shell sed -n 's/^RW_API .*[ *]\(rw_[a-z_]*\)$(PAREN).*/_\1/p' web/rouge_web.c | tr '\n' ',')_malloc,_free,_rouge_free,_rouge_environment_count,_rouge_environment_name,_rouge_cosmetic_count,_rouge_result_name
+WEB_LDFLAGS := -O3 -sMODULARIZE=1 -sEXPORT_ES6=1 -sEXPORT_NAME=createRougeCore -sENVIRONMENT=web \
+    -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB -sMAX_WEBGL_VERSION=2 -sMIN_WEBGL_VERSION=2 \
+    -sEXPORTED_FUNCTIONS=$(WEB_EXPORTS) -sEXPORTED_RUNTIME_METHODS=FS,UTF8ToString,stringToUTF8,lengthBytesUTF8 \
+    -sFILESYSTEM=1 -sMINIFY_HTML=0
+
+web-deps:
+	@sh tools/web_deps.sh $(BUILD)
+
+web: web-deps
+	@$(MAKE) --no-print-directory $(BUILD)/gen/shaders.c
+	@$(MAKE) --no-print-directory $(WEB)/rouge_core.wasm $(WEB)/.assets $(BUILD)/web-bench/cpubench.js
+
+$(WEB_OBJ)/include/.done:
+	@mkdir -p $(dir $@)/cglm
+	cp $(WEB_DEPS)/zlib/zlib.h $(WEB_DEPS)/zlib/zconf.h $(WEB_DEPS)/libpng1.6/png.h $(WEB_DEPS)/libpng1.6/pngconf.h \
+	    $(WEB_DEPS)/libzstd/lib/zstd.h $(WEB_DEPS)/libzstd/lib/zstd_errors.h $(dir $@)
+	cp $(WEB_DEPS)/libpng1.6/scripts/pnglibconf.h.prebuilt $(dir $@)/pnglibconf.h
+	cp -r $$(pkg-config --variable=includedir cglm)/cglm/. $(dir $@)/cglm/
+	@touch $@
+
+$(WEB_OBJ)/zlib/%.o: $(WEB_DEPS)/zlib/%.c $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_3P_CFLAGS) -c $< -o $@
+$(WEB_OBJ)/png/%.o: $(WEB_DEPS)/libpng1.6/%.c $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_3P_CFLAGS) -DPNG_ARM_NEON_OPT=0 -c $< -o $@
+$(WEB_OBJ)/zstd/%.o: $(WEB_DEPS)/libzstd/lib/%.c $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_3P_CFLAGS) -DZSTD_MULTITHREAD=0 -DZSTD_DISABLE_ASM -c $< -o $@
+$(WEB_OBJ)/src/%.o: src/%.c $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_CFLAGS) -MMD -MP -DRS_DATADIR='"/rouge"' -c $< -o $@
+$(WEB_OBJ)/gen/shaders.o: $(BUILD)/gen/shaders.c $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_CFLAGS) -c $< -o $@
+$(WEB_OBJ)/web/%.o: web/%.c include/rouge.h $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_CFLAGS) -c $< -o $@
+
+$(WEB_OBJ)/librouge.a: $(filter-out $(WEB_OBJ)/web/%,$(WEB_LIB_OBJ)) $(WEB_3P_OBJ)
+	@rm -f $@
+	emar rcs $@ $^
+
+EMCC_LINK := NODE_PATH=/usr/share/nodejs$${NODE_PATH:+:$$NODE_PATH} $(EMCC)
+$(WEB)/rouge_core.wasm: $(WEB_OBJ)/web/rouge_web.o $(WEB_OBJ)/librouge.a
+	@mkdir -p $(dir $@)
+	$(EMCC_LINK) $(WEB_LDFLAGS) $^ -o $(WEB)/rouge_core.js
+
+# The CPU-side work of a page (tools/rouge_cpubench.c) as WebAssembly under node, for make bench's ratio.
+$(WEB_OBJ)/tools/%.o: tools/%.c $(WEB_OBJ)/include/.done
+	@mkdir -p $(dir $@)
+	$(EMCC) $(WEB_CFLAGS) -Itools -c $< -o $@
+$(BUILD)/web-bench/cpubench.js: $(WEB_OBJ)/tools/rouge_cpubench.o $(WEB_OBJ)/librouge.a
+	@mkdir -p $(dir $@)
+	$(EMCC_LINK) -O3 -sENVIRONMENT=node -sNODERAWFS=1 -sSINGLE_FILE=1 -sALLOW_MEMORY_GROWTH=1 -sINITIAL_MEMORY=64MB $^ -o $@
+
+# The page, the JS API, the bundled face and environments (with their licences).
+$(WEB)/.assets: $(WEB_PAGE) examples/web/index.html assets/face.rsf $(wildcard assets/env/*.rse) assets/README.md \
+                assets/env/README.md
+	@mkdir -p $(WEB)/env
+	cp $(WEB_PAGE) $(WEB)/
+	cp examples/web/index.html $(WEB)/example.html
+	cp assets/face.rsf assets/README.md $(WEB)/
+	cp assets/env/*.rse assets/env/README.md $(WEB)/env/
+	@touch $@
+
 TEST_SUPPORT_OBJ := $(patsubst %.c,$(BUILD)/obj/%.o,$(sort $(wildcard tests/support/*.c)))
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $(BUILD)/librouge.a $(BUILD)/libpack.a \
@@ -155,8 +242,10 @@ run: deps
 	@$(MAKE) --no-print-directory all
 	@sh tools/run.sh $(BUILD)
 
-test: deps
+# The browser tests (tests/test_web.sh) need the web build: make test builds it too.
+test: deps web-deps
 	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory web
 	@sh tests/run.sh $(BUILD)
 
 # The test suite under AddressSanitizer + UndefinedBehaviorSanitizer, in its own build directory.
@@ -179,31 +268,41 @@ fuzz: deps
 	@sh tools/fuzz.sh
 
 # make install [PREFIX=/usr/local] [DESTDIR=]: the header, both libraries, rouge.pc, the programs and
-# the bundled face and environments they open by default (share/rouge; the programs look there next to
-# their bin/, the library in $(PREFIX)/share/rouge as it was built: build with the PREFIX you install to).
+# the bundled face and environments they open by default (share/rouge). Nothing is rebuilt: the programs
+# look next to their bin/, the library next to its own lib/ (found at run time), so a plain `make` installs
+# to any PREFIX. `make uninstall` removes exactly these files by name (never by glob: another version's
+# library or an .rse file you added stays), the library links only while they point at this version, and
+# the folders install made once they are empty.
 INSTALL_PROGS := $(BUILD)/rouge $(BUILD)/rouge-pack $(BUILD)/rouge-imgdiff $(BUILD)/rouge-profile
+INSTALL_ENVS  := $(notdir $(sort $(wildcard assets/env/*.rse))) README.md
+LIB_REAL      := $(SONAME).$(VERSION:$(SOMAJOR).%=%)
+# cglm is header-only and only src/ includes it: a host linking rouge needs no cglm.pc.
+PC_REQUIRES   := $(filter-out cglm,$(LIB_PKGS))
 I := $(DESTDIR)$(PREFIX)
 install: $(INSTALL_PROGS) $(BUILD)/librouge.a $(BUILD)/$(SONAME)
-	install -d $(I)/bin $(I)/include $(I)/lib/pkgconfig $(I)/share/rouge
+	install -d $(I)/bin $(I)/include $(I)/lib/pkgconfig $(I)/share/rouge/env
 	install -m 755 $(INSTALL_PROGS) $(I)/bin/
 	install -m 644 include/rouge.h $(I)/include/
 	install -m 644 $(BUILD)/librouge.a $(I)/lib/
-	install -m 755 $(BUILD)/$(SONAME) $(I)/lib/$(SONAME).$(VERSION:$(SOMAJOR).%=%)
-	ln -sf $(SONAME).$(VERSION:$(SOMAJOR).%=%) $(I)/lib/$(SONAME)
+	install -m 755 $(BUILD)/$(SONAME) $(I)/lib/$(LIB_REAL)
+	ln -sf $(LIB_REAL) $(I)/lib/$(SONAME)
 	ln -sf $(SONAME) $(I)/lib/librouge.so
 	printf '%s\n' 'prefix=$(PREFIX)' 'exec_prefix=$${prefix}' 'libdir=$${prefix}/lib' 'includedir=$${prefix}/include' '' \
 	    'Name: rouge' 'Description: realistic skin rendering and makeup painting on face scans (OpenGL ES 3)' \
-	    'Version: $(VERSION)' 'Requires.private: $(LIB_PKGS)' 'Libs: -L$${libdir} -lrouge' 'Libs.private: -lm -pthread' \
-	    'Cflags: -I$${includedir}' > $(I)/lib/pkgconfig/rouge.pc
+	    'Version: $(VERSION)' 'Requires.private: $(PC_REQUIRES)' 'Libs: -L$${libdir} -lrouge' \
+	    'Libs.private: -lm -pthread' 'Cflags: -I$${includedir}' > $(I)/lib/pkgconfig/rouge.pc
 	install -m 644 assets/face.rsf assets/README.md $(I)/share/rouge/
-	install -d $(I)/share/rouge/env
-	install -m 644 assets/env/*.rse assets/env/README.md $(I)/share/rouge/env/
+	install -m 644 $(addprefix assets/env/,$(INSTALL_ENVS)) $(I)/share/rouge/env/
 
 uninstall:
 	rm -f $(addprefix $(I)/bin/,$(notdir $(INSTALL_PROGS))) $(I)/include/rouge.h $(I)/lib/librouge.a
-	rm -f $(I)/lib/$(SONAME).* $(I)/lib/$(SONAME) $(I)/lib/librouge.so $(I)/lib/pkgconfig/rouge.pc
-	rm -f $(I)/share/rouge/face.rsf $(I)/share/rouge/README.md $(I)/share/rouge/env/*.rse $(I)/share/rouge/env/README.md
-	-rmdir $(I)/share/rouge/env $(I)/share/rouge 2>/dev/null
+	for l in librouge.so $(SONAME); do \
+	    [ -L $(I)/lib/$$l ] && [ "$$(readlink -f $(I)/lib/$$l)" = "$$(readlink -f $(I)/lib/$(LIB_REAL))" ] && \
+	        rm -f $(I)/lib/$$l; true; \
+	done
+	rm -f $(I)/lib/$(LIB_REAL) $(I)/lib/pkgconfig/rouge.pc
+	rm -f $(I)/share/rouge/face.rsf $(I)/share/rouge/README.md $(addprefix $(I)/share/rouge/env/,$(INSTALL_ENVS))
+	-rmdir $(I)/share/rouge/env $(I)/share/rouge $(I)/lib/pkgconfig 2>/dev/null
 
 # The bundled lighting environments from blender-data's CC0 HDRIs (assets/env/README.md).
 ENV_SRC := /usr/share/blender/datafiles/studiolights/world
@@ -218,4 +317,4 @@ clean:
 	rm -rf build build-*
 
 .SECONDARY:
--include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)
+-include $(shell find $(BUILD)/obj $(BUILD)/web-obj -name '*.d' 2>/dev/null)

@@ -5,7 +5,7 @@
 # Usage: sh tools/bench.sh [BUILD_DIR]       (run from the repository root; `make bench` does)
 # Environment: BENCH_QUICK=1 for a short run (fewer repetitions and views: about a minute on llvmpipe;
 # the full run takes a few minutes), BENCH_ONLY=size,load,rsf (a subset of the rows: size, convert, load,
-# rsf, stamp, memory, frames, env, paint, window), RS_SHARED_DATA for the shared scans (default ../shared/data; rows
+# rsf, stamp, memory, frames, env, paint, window, web), RS_SHARED_DATA for the shared scans (default ../shared/data; rows
 # that need them say "n/a (shared data absent)" without them), BENCH_FACE (default assets/face.rsf).
 # The table also goes to BUILD_DIR/bench.md.
 set -u

@@ -13,9 +13,10 @@
 // A row whose input or program is missing says "n/a (why)" and the rest still runs.
 //
 //   build/rouge-bench --build build [--data ../shared/data] [--quick] [--face assets/face.rsf]
-//                     [--only size,convert,load,rsf,stamp,memory,frames,env,paint,window]   (a subset of the rows)
+//                     [--only size,convert,load,rsf,stamp,memory,frames,env,paint,window,web]   (a subset of the rows)
 #define _DEFAULT_SOURCE  // wait4 (per-child peak memory)
 
+#include "bench_kernels.h"
 #include "formats/env_lookup.h"
 #include "makeup/makeup.h"
 #include "render/render.h"
@@ -92,19 +93,7 @@ static bool wanted(const bench *b, const char *group)
     return false;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
-// Median (sorts in place); the mean of the two middle values for even n.
-static double median(double *v, int n)
-{
-    if (n <= 0) return NAN;
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static bool file_exists(const char *path)
 {
@@ -273,7 +262,7 @@ static void convert_row(bench *b, const char *what, char *const argv[], const ch
     char notes[320];
     snprintf(notes, sizeof notes, "median of %d run%s, whole process (read PLY, normals/radii, LOD order, regions, "
              "write); %u splats; peak RSS %.0f MiB", runs, runs > 1 ? "s" : "", count, rss / 1024.0);
-    double med = median(wall, runs);
+    double med = bench_median(wall, runs);
     add_row(b, what, notes, "%.2f s", med);
 }
 
@@ -321,7 +310,7 @@ static void load_row(bench *b)
     snprintf(what, sizeof what, "load %uk splats (.rsf)", (b->cloud->hdr.count + 500) / 1000);
     snprintf(notes, sizeof notes, "rs_splat_load: read, CRC, validate, decode; median of %d (file in page cache)",
              runs);
-    add_row(b, what, notes, "%.1f ms", median(ms, runs));
+    add_row(b, what, notes, "%.1f ms", bench_median(ms, runs));
 }
 
 // ---- .rsf version 2 ----
@@ -356,7 +345,7 @@ static double time_load(const char *path, bool memory, int runs)
         }
     }
     free(data);
-    return median(ms, runs);
+    return bench_median(ms, runs);
 }
 
 // Time from opening the file until the coarsest LOD level is decoded and a preview cloud of it exists
@@ -441,7 +430,7 @@ static void rsf_rows(bench *b, const char *ply)
         snprintf(notes, sizeof notes, "rs_splat_loader fed 64 KiB reads until the coarsest level (%u splats) is "
                  "decoded and a preview cloud made; %zu of %lld bytes read; median of %d", level, read_bytes,
                  file_size(v2), k);
-        add_row(b, "time to first LOD level (.rsf v2)", notes, "%.2f ms", median(first, k));
+        add_row(b, "time to first LOD level (.rsf v2)", notes, "%.2f ms", bench_median(first, k));
     }
     unlink(v1);
     unlink(v2);
@@ -449,77 +438,32 @@ static void rsf_rows(bench *b, const char *ply)
 
 // ---- brush stamps ----
 
-// Splats a person would paint: a skin region of the face (not `other`) facing the camera.
-static uint32_t face_candidates(const rs_splat_cloud *c, uint32_t **out)
-{
-    uint32_t n = c->hdr.count, k = 0;
-    uint32_t *idx = rs_alloc_array(n, sizeof *idx);
-    if (!idx) return 0;
-    const float *fw = c->hdr.forward;
-    for (uint32_t i = 0; i < n; i++) {
-        uint8_t region = (uint8_t)(c->packed[i].w[1] >> 24);
-        const float *nm = c->normal[i];
-        if (region != RS_REGION_OTHER && nm[0] * fw[0] + nm[1] * fw[1] + nm[2] * fw[2] > 0.5f) idx[k++] = i;
-    }
-    if (k == 0) {  // a face without regions: anything facing forward
-        for (uint32_t i = 0; i < n; i++) {
-            const float *nm = c->normal[i];
-            if (nm[0] * fw[0] + nm[1] * fw[1] + nm[2] * fw[2] > 0.5f) idx[k++] = i;
-        }
-    }
-    *out = idx;
-    return k;
-}
-
 static void stamp_rows(bench *b)
 {
+    enum { MAX_STAMPS = 512 };
     rs_error err = {0};
     rs_makeup *mk = NULL;
     uint32_t *cand = NULL;
-    uint32_t ncand = face_candidates(b->cloud, &cand);
-    const rs_cosmetic *blush = rs_cosmetic_find("blush");
-    if (ncand == 0 || !blush || rs_makeup_create(b->cloud, NULL, &mk, &err) != RS_OK) {
-        add_row(b, "stamp cost", NULL, "n/a (%s)", err.msg[0] ? err.msg : "no face splats / no blush preset");
+    uint32_t ncand = bench_face_candidates(b->cloud, &cand);
+    if (ncand == 0 || rs_makeup_create(b->cloud, NULL, &mk, &err) != RS_OK) {
+        add_row(b, "stamp cost", NULL, "n/a (%s)", err.msg[0] ? err.msg : "no face splats");
         free(cand);
         return;
     }
-    enum { STROKE = 16, MAX_STAMPS = 512 };
     int stamps = b->quick ? 128 : MAX_STAMPS;
     static double us[MAX_STAMPS], touched[MAX_STAMPS];
     const float sizes[3] = {0.1f, 0.2f, 0.3f};
-    uint64_t seed = 0x9E3779B97F4A7C15u;
     for (int s = 0; s < 3; s++) {
-        rs_makeup_range dirty;
-        rs_makeup_reset(mk, &dirty);
-        rs_makeup_stamp_desc d = {.opacity = 0.5f, .pressure = 1.0f, .cosmetic = blush,
-                                  .radius = rs_makeup_brush_radius(&b->cloud->hdr, sizes[s])};
-        memcpy(d.view_dir, b->cloud->hdr.forward, sizeof d.view_dir);
-        rs_result r = RS_OK;
-        for (int i = 0; i < stamps && !r; i++) {
-            if (i % STROKE == 0) rs_makeup_begin_stroke(mk);
-            seed = seed * 6364136223846793005u + 1442695040888963407u;
-            uint32_t at = cand[(uint32_t)(seed >> 33) % ncand];
-            memcpy(d.pos, b->cloud->pos[at], sizeof d.pos);
-            rs_makeup_stamp_info info;
-            double t0 = rs_time_now();
-            r = rs_makeup_stamp(mk, &d, &info, &err);
-            us[i] = (rs_time_now() - t0) * 1e6;
-            touched[i] = info.touched;
-            if (i % STROKE == STROKE - 1 || i == stamps - 1) {
-                if (!r) r = rs_makeup_end_stroke(mk, &err);
-                rs_makeup_forget_history(mk);  // keep the undo history from growing over the run
-            }
-        }
         char what[64], notes[200];
         snprintf(what, sizeof what, "stamp cost, brush size %.1f", sizes[s]);
-        if (r) {
+        if (bench_stamps(b->cloud, mk, cand, ncand, sizes[s], stamps, us, touched, &err) != RS_OK) {
             add_row(b, what, NULL, "n/a (%s)", err.msg);
             continue;
         }
-        double med = median(us, stamps), p90 = us[(stamps * 9) / 10];
+        double med = bench_median(us, stamps), p90 = us[(stamps * 9) / 10];
         snprintf(notes, sizeof notes, "rs_makeup_stamp on %u splats, median of %d at face positions (p90 %.0f µs); "
                  "median %.0f splats touched; goal well under 1 ms", b->cloud->hdr.count, stamps, p90,
-                 median(touched, stamps));
+                 bench_median(touched, stamps));
         add_row(b, what, notes, "%.0f µs", med);
     }
     rs_makeup_destroy(mk);
@@ -626,7 +570,7 @@ static void time_frames(rs_renderer *r[CFG_COUNT], int w, int h, int frames, fra
     }
     for (int c = 0; c < CFG_COUNT; c++) {
         out[c].ok = !failed[c];
-        out[c].ms = failed[c] ? NAN : median(ms[c], frames);
+        out[c].ms = failed[c] ? NAN : bench_median(ms[c], frames);
     }
 }
 
@@ -725,7 +669,7 @@ static void paint_row(bench *b, rs_gl_context *gl)
         if (i >= 0) paint[i] = (rs_time_now() - t0) * 1000.0;
     }
     if (ok) {
-        double p = median(paint, frames), f = median(full, frames);
+        double p = bench_median(paint, frames), f = bench_median(full, frames);
         char notes[240];
         snprintf(notes, sizeof notes, "one stamp + its frame (stages 3 and 5 inside the stamp's rectangle) vs a full "
                  "frame of the same view; %u splats drawn; goal (issue 13): ratio <= 0.25; median of %d", drawn, frames);
@@ -765,7 +709,7 @@ static void env_row(bench *b, rs_gl_context *gl)
             if (i >= 0) ms[k][i] = (rs_time_now() - t0) * 1000.0;
         }
     if (ok) {
-        double e = median(ms[0], frames), p = median(ms[1], frames);
+        double e = bench_median(ms[0], frames), p = bench_median(ms[1], frames);
         char notes[200];
         snprintf(notes, sizeof notes, "environment `%s` (SH x AO into stage 4, prefiltered specular, coat) vs "
                  "`paper` (one lamp); goal (issue 12): <= ~15%% more; median of %d", RS_ENV_DEFAULT, frames);
@@ -808,7 +752,7 @@ static void stage_rows(bench *b, rs_gl_context *gl)
             continue;
         }
         double m[RS_STAGE_COUNT];
-        for (int k = 0; k < RS_STAGE_COUNT; k++) m[k] = median(st[k], n);
+        for (int k = 0; k < RS_STAGE_COUNT; k++) m[k] = bench_median(st[k], n);
         add_row(b, what, "median ms per stage (paper Fig. 2), glFinish after each; the light moves every frame "
                 "(in the frame rows it stays put and the shadow map is cached)",
                 "shadow %.1f, visibility %.1f, attribute %.1f, diffusion %.1f, composite %.1f ms", m[0], m[1], m[2],
@@ -947,6 +891,110 @@ static void window_row(bench *b)
     add_row(b, what, detail ? detail + 2 : result, "%.1f ms", med);
 }
 
+// ---- the web build (make web): wasm vs native, the first LOD level in a browser, page weight ----
+
+// Reads "key value..." lines a child printed into `path`; the value of `key` (NAN when absent).
+static double child_value(const char *path, const char *key)
+{
+    FILE *f = fopen(path, "r");
+    if (!f) return NAN;
+    char line[256];
+    double v = NAN;
+    size_t n = strlen(key);
+    while (fgets(line, sizeof line, f))
+        if (!strncmp(line, key, n) && line[n] == ' ') v = strtod(line + n + 1, NULL);
+    fclose(f);
+    return v;
+}
+
+// Bytes of a file after gzip -9 (what a static host serves compressed); -1 when it cannot be measured.
+static long long gzip_size(const bench *b, const char *file)
+{
+    char out[512], cmd[1200];
+    snprintf(out, sizeof out, "%s/gzip.txt", b->tmp);
+    snprintf(cmd, sizeof cmd, "gzip -9c '%s' | wc -c", file);
+    char *argv[] = {"/bin/sh", "-c", cmd, NULL};
+    child_result c = run_child(argv, out, 60);
+    if (!c.ran || c.status) return -1;
+    FILE *f = fopen(out, "r");
+    long long n = -1;
+    if (f && fscanf(f, "%lld", &n) != 1) n = -1;
+    if (f) fclose(f);
+    return n;
+}
+
+static void web_rows(bench *b)
+{
+    char native[512], wasm[512], out[512], node[64] = "/usr/bin/node";
+    snprintf(native, sizeof native, "%s/rouge-cpubench", b->build);
+    snprintf(wasm, sizeof wasm, "%s/web-bench/cpubench.js", b->build);
+    snprintf(out, sizeof out, "%s/cpubench.txt", b->tmp);
+    if (!file_exists(node)) snprintf(node, sizeof node, "/usr/local/bin/node");
+    if (!file_exists(wasm) || !file_exists(node)) {
+        add_row(b, "wasm / native, CPU work", NULL, "n/a (make web not run, or no node)");
+        return;
+    }
+    progress("the same CPU work natively and as WebAssembly (node)");
+    // Interleaved runs, so a busy moment of the machine hits both alike; medians of the per-run medians.
+    enum { RUNS = 5 };
+    double dn[RUNS], dw[RUNS], sn[RUNS], sw[RUNS];
+    int runs = b->quick ? 2 : RUNS;
+    for (int i = 0; i < runs; i++) {
+        char *an[] = {native, (char *)b->face, "5", NULL}, *aw[] = {node, wasm, (char *)b->face, "5", NULL};
+        child_result c = run_child(an, out, 120);
+        dn[i] = child_value(out, "decode_ms"), sn[i] = child_value(out, "stamp_us");
+        child_result w = run_child(aw, out, 300);
+        dw[i] = child_value(out, "decode_ms"), sw[i] = child_value(out, "stamp_us");
+        if (!c.ran || c.status || !w.ran || w.status) {
+            add_row(b, "wasm / native, CPU work", NULL, "n/a (rouge-cpubench failed: exit %d / %d)", c.status, w.status);
+            return;
+        }
+    }
+    double mdn = bench_median(dn, runs), mdw = bench_median(dw, runs), msn = bench_median(sn, runs),
+           msw = bench_median(sw, runs);
+    add_row(b, "wasm / native, .rsf v2 decode", "rouge-cpubench: rs_splat_load_memory of the bundled face, native vs "
+            "emcc -O3 under node, same run; goal <= 1.5x", "%.2fx (%.1f / %.1f ms)", mdw / mdn, mdw, mdn);
+    add_row(b, "wasm / native, brush stamp", "rouge-cpubench: rs_makeup_stamp, blush size 0.2, 256 stamps; goal <= 1.5x",
+            "%.2fx (%.0f / %.0f µs)", msw / msn, msw, msn);
+
+    // The first LOD level in Chromium (SwiftShader): the page streams the face from a loopback server that
+    // sends it at about 1.5 MB/s (tests/web/run.mjs --bench).
+    char script[512];
+    snprintf(script, sizeof script, "tests/web/run.mjs");
+    if (file_exists(script) && file_exists("/usr/bin/chromium")) {
+        progress("the first LOD level in Chromium");
+        char *argv[] = {node, script, (char *)b->build, "--bench", NULL};
+        child_result c = run_child(argv, out, 300);
+        FILE *f = fopen(out, "r");
+        double v[4] = {NAN, NAN, NAN, NAN};
+        char line[256];
+        while (f && fgets(line, sizeof line, f))
+            if (sscanf(line, "web_first_lod %lf %lf %lf %lf", &v[0], &v[1], &v[2], &v[3]) == 4) break;
+        if (f) fclose(f);
+        if (!c.ran || c.status || isnan(v[3]))
+            add_row(b, "web: first LOD level drawn", NULL, "n/a (browser run failed: exit %d)", c.status);
+        else
+            add_row(b, "web: first LOD level drawn", "Chromium + SwiftShader, 224x224 page, face streamed at ~1.5 MB/s "
+                    "over loopback; then the whole face", "after %.0f KB, %.0f ms (whole face: %.1f MB, %.0f ms)",
+                    v[0] / 1024, v[1], v[2] / 1048576, v[3]);
+    }
+    const char *page[] = {"rouge_core.wasm", "rouge_core.js", "rouge.js", "app.js", "index.html", "style.css"};
+    long long total = 0, raw = 0;
+    for (size_t i = 0; i < RS_COUNT_OF(page); i++) {
+        char file[512];
+        snprintf(file, sizeof file, "%s/web/%s", b->build, page[i]);
+        long long z = gzip_size(b, file);
+        if (z < 0) {
+            add_row(b, "web: page weight", NULL, "n/a (%s missing)", file);
+            return;
+        }
+        total += z, raw += file_size(file);
+    }
+    add_row(b, "web: page weight (gzip -9)", "rouge_core.wasm + .js, rouge.js, app.js, index.html, style.css; besides "
+            "the face (5.4 MB) and environments; goal <= 400 KB", "%.0f KB (%.0f KB uncompressed)", total / 1024.0,
+            raw / 1024.0);
+}
+
 // ---- main ----
 
 static void print_table(const bench *b, FILE *f)
@@ -960,7 +1008,7 @@ static int usage(void)
 {
     fprintf(stderr, "usage: rouge-bench --build DIR [--data DIR] [--face FILE.rsf] [--tmp DIR] [--quick] "
                     "[--out FILE.md]\n"
-                    "                   [--only size,convert,load,rsf,stamp,memory,frames,env,paint,window]\n");
+                    "                   [--only size,convert,load,rsf,stamp,memory,frames,env,paint,window,web]\n");
     return 2;
 }
 
@@ -1052,6 +1100,7 @@ int main(int argc, char **argv)
         rs_gl_destroy(gl);
     }
     if (wanted(b, "window")) window_row(b);
+    if (wanted(b, "web")) web_rows(b);
 
     print_table(b, stdout);
     if (out_md) {

@@ -103,7 +103,7 @@ static rs_result create_headless(rs_gl_context *c, rs_gl_platform want, rs_error
     char why_dev[160] = "EGL_EXT_platform_device not offered";
     if (want == RS_GL_DEVICE) snprintf(why_sl, sizeof why_sl, "not asked for");
     else if (get_display && has_ext(client, "EGL_MESA_platform_surfaceless")) {
-        EGLDisplay dpy = get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, NULL);
+        EGLDisplay dpy = get_display(EGL_PLATFORM_SURFACELESS_MESA, NULL, NULL);
         if (dpy == EGL_NO_DISPLAY) snprintf(why_sl, sizeof why_sl, "no display (%s)", egl_error_name(eglGetError()));
         else if (egl_try_display(c, dpy, why_sl, sizeof why_sl)) {
             snprintf(c->caps.platform, sizeof c->caps.platform, "EGL surfaceless");
