@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 void rs_app_print_looks_help(FILE *f)
 {
@@ -115,8 +116,14 @@ rs_result rs_app_looks(int argc, char **argv, rs_error *err)
     rs_result r = parse(argc, argv, &a, err);
     if (r != RS_OK) return r;
     char dir[1024];
+    // A longer path is refused, not cut (it would name another folder).
+    if (a.dir && strlen(a.dir) >= sizeof dir)
+        return rs_fail(err, RS_ERR_ARG, "--looks: the path is %zu bytes, at most %zu allowed", strlen(a.dir), sizeof dir - 1);
     if (a.dir) snprintf(dir, sizeof dir, "%s", a.dir);
     else if ((r = rs_looklib_default_dir(dir, sizeof dir, err)) != RS_OK) return r;
+    // The folder comes from XDG_DATA_HOME or --looks: printed terminal-safe (no escape sequences).
+    char shown[4 * sizeof dir];
+    rs_text_sanitize(shown, sizeof shown, dir, strlen(dir));
 
     if (!strcmp(a.verb, "list")) {
         rs_looklib_entry *e = NULL;
@@ -129,7 +136,7 @@ rs_result rs_app_looks(int argc, char **argv, rs_error *err)
             if (localtime_r(&t, &tm)) strftime(when, sizeof when, "%Y-%m-%d %H:%M", &tm);
             printf("%-*s  %s  %s\n", RS_LOOKLIB_NAME_MAX, e[i].name, when, e[i].has_thumb ? "thumbnail" : "-");
         }
-        if (n == 0) fprintf(stderr, "rouge: no looks in %s\n", dir);
+        if (n == 0) fprintf(stderr, "rouge: no looks in %s\n", shown);
         free(e);
         return RS_OK;
     }
@@ -137,7 +144,10 @@ rs_result rs_app_looks(int argc, char **argv, rs_error *err)
         char path[1100];
         if ((r = rs_looklib_path(dir, a.name, false, path, sizeof path, err)) != RS_OK) return r;
         if (!rs_looklib_exists(dir, a.name)) return rs_fail(err, RS_ERR_ARG, "no look named '%s' in %s", a.name, dir);
-        printf("%s\n", path);
+        // Raw for a script that reads it ($(rouge looks path X)), terminal-safe on a terminal.
+        char safe[4 * sizeof path];
+        rs_text_sanitize(safe, sizeof safe, path, strlen(path));
+        printf("%s\n", isatty(STDOUT_FILENO) ? safe : path);
         return RS_OK;
     }
     if (!strcmp(a.verb, "rm")) {
@@ -162,7 +172,7 @@ rs_result rs_app_looks(int argc, char **argv, rs_error *err)
     char def[600];
     if (!a.no_thumb) r = rs_app_thumbnail(a.face ? a.face : rs_app_default_face(def, sizeof def), data, len, &thumb, err);
     if (r == RS_OK) r = rs_looklib_save(dir, a.name, data, len, a.no_thumb ? NULL : &thumb, a.force, err);
-    if (r == RS_OK) printf("rouge: saved look '%s' in %s\n", a.name, dir);
+    if (r == RS_OK) printf("rouge: saved look '%s' in %s\n", a.name, shown);
     free(data);
     rs_image_free(&thumb);
     return r;

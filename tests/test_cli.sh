@@ -168,3 +168,13 @@ else echo "FAIL - cli_looks_path_prints_the_file: $(cat "$tmp/out")"; fi
 expect cli_looks_rm 0 "" "$rouge" looks rm "Red lips" --looks "$lib"
 expect cli_looks_rm_unknown 2 "no look named 'Red lips'" "$rouge" looks rm "Red lips" --looks "$lib"
 expect cli_looks_list_empty 0 "no looks in" "$rouge" looks list --looks "$lib"
+# Issue 23: a --looks path too long for the buffer is refused (it was cut to another folder); escape bytes
+# in XDG_DATA_HOME are printed escaped, not sent to the terminal.
+long=$(printf '%01100d' 0)
+expect cli_looks_long_folder_refused 2 "--looks: the path is 1101 bytes" "$rouge" looks list --looks "/$long"
+esc_home="$tmp/x$(printf '\033')]0;owned$(printf '\007')"
+mkdir -p "$esc_home"
+expect cli_looks_folder_printed_escaped 0 'no looks in .*x\\x1b\]0;owned\\x07/rouge/looks' \
+    env XDG_DATA_HOME="$esc_home" "$rouge" looks list
+if LC_ALL=C grep -q "$(printf '\033')" "$tmp/err"; then echo "FAIL - cli_looks_folder_no_raw_escape: raw ESC printed"
+else echo "ok - cli_looks_folder_no_raw_escape"; fi

@@ -93,6 +93,22 @@ expect env_tool_not_hdr 1 "neither OpenEXR nor Radiance" "$env_tool" "$fx/bad_no
 expect env_tool_truncated_exr 1 "bad_truncated.exr: OpenEXR:" "$env_tool" "$fx/bad_truncated.exr" -o "$tmp/b.rse" --name t
 expect env_tool_huge_exr 1 "too large (max 8192)" "$env_tool" "$fx/bad_huge.exr" -o "$tmp/b.rse" --name t
 expect env_tool_garbage_exr 1 "bad_garbage.exr: OpenEXR:" "$env_tool" "$fx/bad_garbage.exr" -o "$tmp/b.rse" --name t
+# Captures with no light (the face rendered black, denormals cost 4x the CPU) and infinite values: one line
+# naming the input and the problem (tests/support/hostile_models.sh writes them).
+. tests/support/hostile_models.sh
+hostile_exr "$tmp/all_nan.exr" 0 0 192 127
+hostile_exr "$tmp/all_zero.exr" 0 0 0 0
+hostile_exr "$tmp/all_negative.exr" 0 0 128 191
+hostile_exr "$tmp/all_denormal.exr" 194 22 1 0
+hostile_exr "$tmp/inf.exr" 0 0 128 127
+expect env_tool_all_nan 1 "all_nan.exr: every value is NaN" "$env_tool" "$tmp/all_nan.exr" -o "$tmp/b.rse" --name t
+expect env_tool_all_zero 1 "all_zero.exr: every value is 0 or denormal" "$env_tool" "$tmp/all_zero.exr" -o "$tmp/b.rse" --name t
+expect env_tool_all_negative 1 "all_negative.exr: every value is negative" "$env_tool" "$tmp/all_negative.exr" -o "$tmp/b.rse" --name t
+expect env_tool_all_denormal 1 "all_denormal.exr: every value is 0 or denormal" "$env_tool" "$tmp/all_denormal.exr" -o "$tmp/b.rse" --name t
+expect env_tool_infinite 1 "inf.exr: 1536 of its 1536 values are infinite" "$env_tool" "$tmp/inf.exr" -o "$tmp/b.rse" --name t
+no_file env_tool_no_light_leaves_no_output "$tmp/b.rse"
+hostile_exr "$tmp/grey.exr" 0 0 128 63
+expect env_tool_generated_grey_capture_converts 0 "" "$env_tool" "$tmp/grey.exr" -o "$tmp/grey.rse" --name t
 printf '' >"$tmp/empty.exr"
 expect env_tool_empty_file 1 "neither OpenEXR nor Radiance" "$env_tool" "$tmp/empty.exr" -o "$tmp/b.rse" --name t
 no_file env_tool_bad_inputs_leave_no_output "$tmp/b.rse"

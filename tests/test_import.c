@@ -162,6 +162,68 @@ static void test_bad_models_fail_with_one_line(void)
     rs_import_destroy(s);
 }
 
+// Hostile structure is refused in this process before assimp reads it (the memory import is the fuzz
+// harness's path, with no child process behind it): deep nesting, a cycle of instances, a node instanced
+// past the unrolled-node limit, an FBX array claiming more than its compressed bytes hold.
+static void test_guard_refuses_hostile_structure(void)
+{
+    size_t cap = 1 << 20, n = 0;
+    char *deep = malloc(cap);
+    RS_REQUIRE(deep, "out of memory");
+    // JSON nested 300 deep, and a glTF whose node 1 lists itself as a child.
+    for (int i = 0; i < 300; i++) deep[n++] = '[';
+    for (int i = 0; i < 300; i++) deep[n++] = ']';
+    static const char cycle[] = "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"children\":[1]},{\"children\":[2]},{\"children\":[1]}]}";
+    // A chain of 30 COLLADA nodes each instancing the next one twice: 2^30 nodes once unrolled.
+    char *dae = malloc(cap);
+    RS_REQUIRE(dae, "out of memory");
+    size_t m = (size_t)snprintf(dae, cap, "<COLLADA><library_nodes>");
+    for (int i = 0; i < 30; i++)
+        m += (size_t)snprintf(dae + m, cap - m, "<node id=\"n%d\"><instance_node url=\"#n%d\"/><instance_node url=\"#n%d\"/></node>",
+                              i, i + 1, i + 1);
+    m += (size_t)snprintf(dae + m, cap - m, "<node id=\"n30\"/></library_nodes></COLLADA>");
+    // FBX 7.4: one record whose 'd' array claims 2^28 - 1 doubles from 8 zlib bytes.
+    uint8_t fbx[128] = "Kaydara FBX Binary  \0\x1a\0";
+    size_t f = 23;
+    rs_le32_put(fbx + f, 7400), f += 4;
+    size_t rec = f;
+    f += 13;  // end offset, property count, property bytes, name length: filled below
+    memcpy(fbx + f, "Vertices", 8), f += 8;
+    fbx[f++] = 'd';
+    rs_le32_put(fbx + f, (1u << 28) - 1), rs_le32_put(fbx + f + 4, 1), rs_le32_put(fbx + f + 8, 8), f += 12;
+    memcpy(fbx + f, "\x78\x9c\x03\x00\x00\x00\x00\x01", 8), f += 8;
+    rs_le32_put(fbx + rec, (uint32_t)f), rs_le32_put(fbx + rec + 4, 1), rs_le32_put(fbx + rec + 8, 21), fbx[rec + 12] = 8;
+    f += 13;  // the closing null record
+    struct {
+        const void *data;
+        size_t len;
+        const char *hint, *want;
+    } cases[] = {
+        {deep, n, "gltf", "JSON objects and arrays nested more than 256 deep"},
+        {cycle, sizeof cycle - 1, "gltf", "glTF node 1 contains itself"},
+        {dae, m, "dae", "unrolls to more than 1048576 nodes"},
+        {fbx, f, "fbx", "claims 2147483640 bytes from 8 stored bytes"},
+    };
+    for (size_t i = 0; i < RS_COUNT_OF(cases); i++) {
+        rs_error err = {0};
+        RS_CHECK(rs_import_guard(cases[i].data, cases[i].len, RS_IMPORT_OTHER, "x", &err) != RS_OK &&
+                     strstr(err.msg, cases[i].want), "case %zu: %s", i, err.msg);
+        rs_import_scene *s = NULL;
+        RS_CHECK(rs_import_load_memory(cases[i].data, cases[i].len, cases[i].hint, &s, &err) != RS_OK && !s &&
+                     strstr(err.msg, cases[i].want) && !strchr(err.msg, '\n'), "case %zu: %s", i, err.msg);
+        rs_import_destroy(s);
+    }
+    // The fixtures people's files look like pass.
+    void *data;
+    size_t len;
+    rs_error err = {0};
+    RS_REQUIRE(rs_file_read_all(FX "square.glb", 1 << 20, &data, &len, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(rs_import_guard(data, len, RS_IMPORT_GLTF, "square.glb", &err) == RS_OK, "%s", err.msg);
+    free(data);
+    free(deep);
+    free(dae);
+}
+
 // The same model from memory (the fuzz harness's path) reads like the file.
 static void test_memory_import_matches_file(void)
 {
@@ -508,6 +570,7 @@ int main(int argc, char **argv)
     RS_RUN(test_stl_and_ply_route);
     RS_RUN(test_bad_models_fail_with_one_line);
     RS_RUN(test_memory_import_matches_file);
+    RS_RUN(test_guard_refuses_hostile_structure);
     RS_RUN(test_jpeg_and_png_textures_decode_with_limits);
     RS_RUN(test_lee_perry_smith_glb_matches_ply);
     RS_RUN(test_scale_rule_reads_units_from_the_head);

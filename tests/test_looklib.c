@@ -6,6 +6,7 @@
 #include "formats/looklib.h"
 
 #include <dirent.h>
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -283,6 +284,49 @@ static void test_unwritable_folder_fails_cleanly(void)
     free(e);
 }
 
+// A saver killed mid-save (SIGKILL) leaves .NAME.look.tmp.PID: the next save or rm of that name removes
+// the ones whose process is gone, and keeps a live saver's.
+static void test_stale_temporaries_of_dead_savers_are_removed(void)
+{
+    char dir[600], dead[800], dead_png[800], live[800];
+    rs_error err = {0};
+    fresh_dir("stale", dir, sizeof dir);
+    REQUIRE(mkdir(dir, 0755) == 0 || errno == EEXIST);
+    pid_t pid = fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) _exit(0);
+    waitpid(pid, NULL, 0);  // now a PID no process has
+    snprintf(dead, sizeof dead, "%s/.Evening.look.tmp.%ld", dir, (long)pid);
+    snprintf(dead_png, sizeof dead_png, "%s/.Evening.png.tmp.%ld", dir, (long)pid);
+    snprintf(live, sizeof live, "%s/.Evening.look.tmp.%ld", dir, (long)getppid());
+    REQUIRE(rs_file_write_atomic(dead, "x", 1, &err) == RS_OK && rs_file_write_atomic(dead_png, "x", 1, &err) == RS_OK);
+    REQUIRE(rs_file_write_atomic(live, "x", 1, &err) == RS_OK);
+    RS_CHECK(rs_looklib_save(dir, "Evening", "x", 1, NULL, false, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(access(dead, F_OK) != 0 && access(dead_png, F_OK) != 0, "a dead saver's temporaries stayed");
+    RS_CHECK(access(live, F_OK) == 0, "a live saver's temporary was removed");
+    // rm of a name that only has a dead temporary left: the temporary goes, the answer is "no look".
+    REQUIRE(rs_file_write_atomic(dead, "x", 1, &err) == RS_OK);
+    RS_CHECK(rs_looklib_remove(dir, "Evening", &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(rs_looklib_remove(dir, "Evening", &err) == RS_ERR_ARG, "second rm");
+    RS_CHECK(access(dead, F_OK) != 0, "rm left a dead saver's temporary");
+    unlink(live);
+}
+
+// A failure writing the temporary (here a directory in its place; a full disk alike) names the look,
+// not the hidden temporary.
+static void test_write_failure_names_the_look(void)
+{
+    char dir[600], tmp[800];
+    rs_error err = {0};
+    fresh_dir("full", dir, sizeof dir);
+    REQUIRE(mkdir(dir, 0755) == 0 || errno == EEXIST);
+    snprintf(tmp, sizeof tmp, "%s/.Evening.look.tmp.%ld", dir, (long)getpid());
+    REQUIRE(mkdir(tmp, 0755) == 0);
+    RS_CHECK(rs_looklib_save(dir, "Evening", "x", 1, NULL, false, &err) == RS_ERR_IO && strstr(err.msg, "/Evening.look") &&
+                 !strstr(err.msg, ".tmp."), "%s", err.msg);
+    rmdir(tmp);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -291,5 +335,7 @@ int main(int argc, char **argv)
     RS_RUN(test_bad_names_are_refused_with_a_reason);
     RS_RUN(test_default_folder_follows_xdg);
     RS_RUN(test_unwritable_folder_fails_cleanly);
+    RS_RUN(test_stale_temporaries_of_dead_savers_are_removed);
+    RS_RUN(test_write_failure_names_the_look);
     return rs_test_finish();
 }

@@ -38,7 +38,7 @@ bad_input() {
     name=robust_$1 what=$2 want=$3 pat=$4 output=$5
     shift 5
     selected "$name" || return 0
-    case $1 in render | env) prog=$rouge ;; *) prog=$1 ;; esac
+    case $1 in render | env) prog=$rouge ;; bounded) prog=$2 ;; *) prog=$1 ;; esac
     if [ ! -x "$prog" ]; then
         echo "skip - $name: $prog not built"
         return 0
@@ -65,11 +65,19 @@ bad_input() {
     fi
     if [ -n "$table" ]; then
         # The command as a reader would type it: scratch paths shortened, the build dir as "build".
-        cmd=$(printf '%s ' "$@" | sed -e "s#$tmp/#/tmp/#g" -e "s#^render #build/rouge render #" \
+        cmd=$(printf '%s ' "$@" | sed -e "s#$tmp/#/tmp/#g" -e "s#^render #build/rouge render #" -e "s#^bounded ##" \
             -e "s#\(^\| \)$build/#\1build/#g" -e 's/ $//')
         msg=$(head -n 1 "$tmp/err" | sed -e "s#$tmp/#/tmp/#g" -e 's/|/\\|/g')
         printf '| %s | `%s` | exit %s: `%s` |\n' "$what" "$cmd" "$rc" "$msg" >>"$table"
     fi
+}
+
+# Hostile inputs run with bounded memory and time: a bomb that is not refused fails the test instead of
+# taking the machine (2 GB of address space, 60 s). Not the address space under AddressSanitizer (make
+# asan), which reserves terabytes of it up front.
+asan_build=$(ldd "$pack" 2>/dev/null | grep -c libasan)
+bounded() {
+    if [ "$asan_build" -gt 0 ]; then timeout 60 "$@"; else (ulimit -v 2000000 && exec timeout 60 "$@"); fi
 }
 
 render() {  # the smallest render that still loads the whole face and makes a GL context
@@ -104,6 +112,9 @@ rsf_radius_bomb.rsf|radius_max: 1e+07 is more than 4 times the bounding box|radi
 rsf_inf_mm_per_unit.rsf|mm_per_unit:|infinite scale
 rsf_forward_not_unit.rsf|forward:|face frame not unit length
 rsf_negative_face_height.rsf|face_height:|negative face height
+rsf_centre_3e38.rsf|centre[0]: 3e+38 lies far outside|face centre 3e38 (rendered blank before)
+rsf_face_height_1e-30.rsf|face_height: 1e-30 is implausible|face height 1e-30 (rendered blank before)
+rsf_face_height_3e38.rsf|face_height: 3e+38 is implausible|face height 3e38 (rendered blank before)
 rsf_lod_count_huge.rsf|lod_count:|1000 LOD levels
 rsf_lods_ascending.rsf|lods[1]:|LOD table not descending
 rsf_region_count_huge.rsf|region_count:|200 regions
@@ -190,6 +201,78 @@ bad_input import_texture_huge_jpeg "--texture: JPEG header claiming 16000 x 1600
     "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture tests/fixtures/import/bad_huge.jpg -o "$tmp/o.rsf"
 bad_input import_texture_jpeg_bomb "--texture: 622-byte JPEG claiming 8000 x 8000 pixels" 1 "cannot hold" "$tmp/o.rsf" \
     "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture tests/fixtures/import/bad_bomb.jpg -o "$tmp/o.rsf"
+# ---- hostile models through assimp (issue 23; generated here by tests/support/hostile_models.sh) ----
+. tests/support/hostile_models.sh
+hm="$tmp/hostile"
+mkdir -p "$hm"
+deep_dae "$hm/deep.dae" 100000
+self_dae "$hm/self.dae"
+deep_gltf "$hm/deep.gltf" 100000
+deep_glb "$hm/deep.glb" 100000
+deep_fbx "$hm/deep.fbx" 100000
+bomb_gltf "$hm/bomb.gltf"
+bomb_fbx "$hm/bomb.fbx"
+# DirectX .x: a format nothing checks before assimp, so the child process has to catch the overflow.
+{ printf 'xof 0303txt 0032\n'; LC_ALL=C awk 'BEGIN { for (i = 0; i < 100000; i++) printf "Frame f%d {\n", i; for (i = 0; i < 100000; i++) print "}" }'; } >"$hm/deep.x"
+while IFS='|' read -r file pat what; do
+    bad_input "import_hostile_${file%%.*}_${file#*.}" "$what" 1 "$pat" "$tmp/o.rsf" \
+        bounded "$pack" "$hm/$file" -o "$tmp/o.rsf"
+done <<'EOF2'
+deep.dae|XML elements nested more than 256 deep|COLLADA: nodes nested 100000 deep (a stack overflow before)
+self.dae|contains itself|COLLADA: a node that instances itself (a stack overflow before)
+deep.gltf|heads a hierarchy more than 256 deep|glTF: a node chain 100000 deep (a stack overflow before)
+deep.glb|heads a hierarchy more than 256 deep|GLB: a node chain 100000 deep (a stack overflow before)
+deep.fbx|FBX records nested more than 256 deep|FBX (binary): records nested 100000 deep (a stack overflow before)
+bomb.gltf|an instancing bomb|glTF: 10^4 nodes instancing a 10^4-triangle mesh (6.8 GB before)
+bomb.fbx|a decompression bomb|FBX: 496 bytes, an array claiming 2 GiB (3.2 GB and a junk .rsf before)
+deep.x|assimp crashed reading it|DirectX .x: frames nested 100000 deep (caught by the child process)
+EOF2
+# Files an OBJ names: a missing MTL converts with a warning; a FIFO, /dev/zero or a directory as the MTL,
+# and textures outside the model's folder, are errors that never quote the file's bytes.
+mo="$hm/obj"
+mkdir -p "$mo/dir.mtl" "$mo/dirtex"
+mkfifo "$mo/fifo.mtl" "$mo/fifo.png"
+printf 'secret bytes\n' >"$hm/secret.png"
+obj_naming() {  # obj_naming NAME MTL: a one-triangle OBJ with UVs naming the MTL
+    printf 'mtllib %s\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl skin\nf 1/1 2/2 3/3\n' "$2" >"$mo/$1.obj"
+}
+obj_naming mtl_missing missing.mtl
+obj_naming mtl_fifo fifo.mtl
+obj_naming mtl_dev_zero /dev/zero
+obj_naming mtl_directory dir.mtl
+for t in abs:"$hm/secret.png" up:../secret.png fifo:fifo.png dev_zero:/dev/zero directory:dirtex; do
+    printf 'newmtl skin\nmap_Kd %s\n' "${t#*:}" >"$mo/tex_${t%%:*}.mtl"
+    obj_naming "tex_${t%%:*}" "tex_${t%%:*}.mtl"
+done
+while IFS='|' read -r file pat what; do
+    bad_input "import_$file" "$what" 1 "$pat" "$tmp/o.rsf" bounded "$pack" "$mo/$file.obj" -o "$tmp/o.rsf" --points 100
+done <<'EOF2'
+mtl_fifo|fifo.mtl: not a regular file|OBJ whose MTL is a FIFO (converted untextured before)
+mtl_dev_zero|'/dev/zero', outside the model's folder|OBJ whose MTL is /dev/zero (converted untextured before)
+mtl_directory|dir.mtl: not a regular file|OBJ whose MTL is a directory (converted untextured before)
+tex_abs|outside the model's folder|MTL naming an absolute texture path outside the model's folder
+tex_up|'../secret.png', outside the model's folder|MTL naming ../secret.png
+tex_fifo|fifo.png: not a regular file|MTL naming a FIFO as the texture
+tex_dev_zero|outside the model's folder|MTL naming /dev/zero as the texture
+tex_directory|dirtex: not a regular file|MTL naming a directory as the texture
+EOF2
+if selected robust_import_no_bytes_echoed; then
+    # Even when the user allows outside paths, an error never quotes a file the user did not name.
+    bounded "$pack" "$mo/tex_up.obj" --allow-outside-paths -o "$tmp/o.rsf" --points 100 >/dev/null 2>"$tmp/err"
+    rc=$?
+    if [ $rc -ne 1 ] || grep -q "starts\|73 65 63" "$tmp/err" || ! grep -q "not a PNG or JPEG" "$tmp/err"; then
+        echo "FAIL - robust_import_no_bytes_echoed: exit $rc: $(head -c 300 "$tmp/err")"
+    else echo "ok - robust_import_no_bytes_echoed"; fi
+fi
+if selected robust_import_mtl_missing_warns; then
+    bounded "$pack" "$mo/mtl_missing.obj" -o "$tmp/w.rsf" --points 100 -q >/dev/null 2>"$tmp/err"
+    rc=$?
+    if [ $rc -ne 0 ] || ! grep -q "warning: .*'.*missing.mtl', which is not there.*converted without it" "$tmp/err"; then
+        echo "FAIL - robust_import_mtl_missing_warns: exit $rc: $(head -c 300 "$tmp/err")"
+    else echo "ok - robust_import_mtl_missing_warns"; fi
+    rm -f "$tmp/w.rsf"
+fi
+
 bad_input pack_region_map_not_png "--region-map: a PLY instead of a PNG" 1 "--region-map" "$tmp/o.rsf" \
     "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --region-map tests/fixtures/ply/points_le.ply \
     -o "$tmp/o.rsf"

@@ -704,6 +704,47 @@ static void test_quantized_radii_stay_within_3_codes(void)
     rs_splat_destroy(c);
 }
 
+// A version-1 header is judged once its fixed part (588 bytes) has arrived, before the records it claims
+// are buffered: `rouge view -` used to buffer up to 1 GiB of a bad header's claim first.
+static void test_v1_stream_judges_the_header_before_buffering(void)
+{
+    void *data;
+    size_t len;
+    rs_error err = {0};
+    RS_REQUIRE(rs_file_read_all("tests/fixtures/bad/rsf_face_height_1e-30.rsf", 1 << 20, &data, &len, &err) == RS_OK,
+               "%s", err.msg);
+    uint8_t *b = data;
+    // 2^26 - 1 splats: a 1 GiB claim.
+    rs_le32_put(b + RSF_OFF_COUNT, (1u << 26) - 1);
+    rs_le32_put(b + RSF_OFF_LODS, (1u << 26) - 1);
+    rs_splat_loader *l = NULL;
+    RS_REQUIRE(rs_splat_loader_create(&(rs_splat_loader_desc){.name = "(standard input)"}, &l, &err) == RS_OK, "%s", err.msg);
+    static uint8_t zeros[100];
+    size_t fed = 0;
+    rs_result r = RS_OK;
+    for (size_t at = 0; r == RS_OK && fed < (1u << 20); at += 100) {
+        const uint8_t *piece = at < len ? b + at : zeros;
+        size_t n = at < len ? RS_MIN(len - at, (size_t)100) : sizeof zeros;
+        r = rs_splat_loader_feed(l, piece, n, &err);
+        fed += n;
+    }
+    RS_CHECK(r != RS_OK && fed <= 600 && strstr(err.msg, "(standard input): face_height: 1e-30 is implausible"),
+             "fed %zu bytes: %s", fed, err.msg);
+    rs_splat_loader_destroy(l);
+    free(data);
+    // The header fields that pass every finiteness check but cannot be framed, from files.
+    static const char *const bad[][2] = {
+        {"tests/fixtures/bad/rsf_centre_3e38.rsf", "centre[0]: 3e+38 lies far outside the bounding box"},
+        {"tests/fixtures/bad/rsf_face_height_1e-30.rsf", "face_height: 1e-30 is implausible"},
+        {"tests/fixtures/bad/rsf_face_height_3e38.rsf", "face_height: 3e+38 is implausible"},
+    };
+    for (size_t i = 0; i < RS_COUNT_OF(bad); i++) {
+        rs_splat_cloud *c = NULL;
+        RS_CHECK(rs_splat_load(bad[i][0], &c, &err) != RS_OK && !c && strstr(err.msg, bad[i][1]), "%s: %s", bad[i][0], err.msg);
+        rs_splat_destroy(c);
+    }
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -724,6 +765,7 @@ int main(int argc, char **argv)
     RS_RUN(test_preview_is_the_prefix_with_scaled_radii);
     RS_RUN(test_loader_refuses_bytes_after_the_end);
     RS_RUN(test_v1_stream_decodes_at_finish);
+    RS_RUN(test_v1_stream_judges_the_header_before_buffering);
     RS_RUN(test_stream_of_something_else_is_refused_at_once);
     RS_RUN(test_quantized_normals_stay_within_0_05_degrees);
     RS_RUN(test_quantized_radii_stay_within_3_codes);

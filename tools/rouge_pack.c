@@ -46,6 +46,14 @@ static const char usage[] =
     "  --all-components    mesh: sample every connected component; by default only the largest (by\n"
     "                      area) is kept, which on a scan is the skin, not caps or mouth/eye pockets\n"
     "  Inputs without colour get a light warm grey (sRGB 200 178 160).\n"
+    "  --allow-outside-paths  read files the model names (MTL, glTF buffers, textures) from anywhere; by\n"
+    "                      default only from the model's folder and below (a model cannot make rouge-pack\n"
+    "                      read /etc/passwd or ../../secret; a texture named outside it is looked for by\n"
+    "                      its bare name in the folder). A missing MTL is a warning; a named file that is\n"
+    "                      not a regular file (a FIFO, /dev/zero, a directory) is an error\n"
+    "  Hostile models: nesting deeper than 256 levels, nodes that contain themselves, arrays claiming more\n"
+    "  than their compressed bytes hold and instancing past the triangle limit are refused before they\n"
+    "  are expanded; assimp reads the file in a child process limited to 8 GiB and 600 CPU seconds.\n"
     "\n"
     "Face (one front-facing head: a bust, a whole head or a face-only scan; the nose is its sharpest\n"
     "bump). Its frame is found from the scan in any orientation: the mirror plane, the nose, the\n"
@@ -308,6 +316,7 @@ typedef struct options {
     const char *maps[4];  // texture, normal, specular, region
     rs_pack_desc desc;
     bool quiet;
+    rs_import_desc import;
     char format[64];          // what the input was read as ("PLY", "glTF 2.0", ...)
     char declared_unit[96];   // the unit the file declares, in words (or "")
     const char *units;        // --units as given
@@ -389,7 +398,7 @@ static int convert(options *o)
 
     double t0 = rs_time_now();
     rs_import_scene *scene = NULL;
-    if (rs_import_load(o->input, &scene, &err) != RS_OK) return fail(1, "%s", err.msg);
+    if (rs_import_load_with(o->input, &o->import, &scene, &err) != RS_OK) return fail(1, "%s", err.msg);
     rs_ply_mesh *mesh = scene->mesh;
     snprintf(o->format, sizeof o->format, "%s", scene->format_name);
     snprintf(o->declared_unit, sizeof o->declared_unit, "%s", scene->unit_source);
@@ -516,6 +525,9 @@ int main(int argc, char **argv)
             takes = false;
         } else if (!strcmp(a, "--no-ao")) {
             o.desc.no_ao = true;
+            takes = false;
+        } else if (!strcmp(a, "--allow-outside-paths")) {
+            o.import.allow_outside_paths = true;
             takes = false;
         } else if (a[0] == '-' && a[1] != 0) {
             static const char *const known[] = {"-o", "--output", "--points", "--texture", "--normal-map",

@@ -5,6 +5,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -106,6 +107,42 @@ static void sync_dir(const char *dir)
     }
 }
 
+// Temporaries a saver left when it was killed (.NAME.look.tmp.PID, .NAME.png.tmp.PID whose PID is gone):
+// nothing else ever removes them (later saves use their own PID; list and rm never see hidden files).
+static void remove_stale_temps(const char *dir, const char *name)
+{
+    DIR *d = opendir(dir);
+    if (!d) return;
+    size_t nl = strlen(name);
+    struct dirent *de;
+    while ((de = readdir(d)) != NULL) {
+        const char *f = de->d_name, *rest = f + 1 + nl;
+        if (f[0] != '.' || strncmp(f + 1, name, nl) != 0) continue;
+        if (!strncmp(rest, ".look.tmp.", 10)) rest += 10;
+        else if (!strncmp(rest, ".png.tmp.", 9)) rest += 9;
+        else continue;
+        char *end;
+        long pid = strtol(rest, &end, 10);
+        if (end == rest || *end || pid <= 0 || pid == (long)getpid()) continue;
+        // A live saver's temporary stays (kill with signal 0 only asks whether the process exists).
+        if (kill((pid_t)pid, 0) == 0 || errno != ESRCH) continue;
+        char path[1100];
+        if (snprintf(path, sizeof path, "%s/%s", dir, f) < (int)sizeof path) unlink(path);
+    }
+    closedir(d);
+}
+
+// A failure writing a temporary names the look, not the hidden file (a full disk said
+// ".Evening.look.tmp.812: write failed: No space left on device").
+static rs_result name_the_look(rs_result r, const char *tmp, const char *look, rs_error *err)
+{
+    size_t n = strlen(tmp);
+    if (r == RS_OK || !err || strncmp(err->msg, tmp, n) != 0) return r;
+    char rest[sizeof err->msg];
+    snprintf(rest, sizeof rest, "%s", err->msg + n);
+    return rs_fail(err, r, "looks: cannot save %s%s", look, rest);
+}
+
 rs_result rs_looklib_save(const char *dir, const char *name, const void *look_text, size_t len,
                           const rs_image *thumb, bool overwrite, rs_error *err)
 {
@@ -124,8 +161,9 @@ rs_result rs_looklib_save(const char *dir, const char *name, const void *look_te
                     name);
     if (r == RS_OK) r = make_dirs(dir, err);
     if (r != RS_OK) return r;
-    r = rs_file_write_atomic(tmp_look, look_text, len, err);
-    if (r == RS_OK && thumb) r = rs_image_write_png(tmp_png, thumb, err);
+    remove_stale_temps(dir, name);
+    r = name_the_look(rs_file_write_atomic(tmp_look, look_text, len, err), tmp_look, look, err);
+    if (r == RS_OK && thumb) r = name_the_look(rs_image_write_png(tmp_png, thumb, err), tmp_png, png, err);
     if (r == RS_OK) {
         // Without overwrite the new name is made by link(), which fails if it exists: no check-then-write
         // race with another saver.
@@ -205,6 +243,7 @@ rs_result rs_looklib_remove(const char *dir, const char *name, rs_error *err)
     rs_result r = rs_looklib_path(dir, name, false, look, sizeof look, err);
     if (r == RS_OK) r = rs_looklib_path(dir, name, true, png, sizeof png, err);
     if (r != RS_OK) return r;
+    remove_stale_temps(dir, name);
     if (!is_regular(look, NULL)) return rs_fail(err, RS_ERR_ARG, "no look named '%s' in %s", name, dir);
     if (unlink(look) != 0) return rs_fail(err, RS_ERR_IO, "looks: cannot remove %s: %s", look, strerror(errno));
     unlink(png);

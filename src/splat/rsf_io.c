@@ -235,6 +235,25 @@ static rs_result check_layout(const uint8_t *b, size_t len, const char *name, rs
     return RS_OK;
 }
 
+rs_result rs_rsf1_check_head(const uint8_t *b, size_t len, const char *name, rs_error *err)
+{
+    if (len < RSF_OFF_NOTES || memcmp(b, rsf_magic, sizeof rsf_magic) != 0) return RS_OK;  // check_layout says why
+    uint32_t notes_len = rs_le32_get(b + RSF_OFF_NOTES_LEN), header_size = rs_le32_get(b + RSF_OFF_HEADER_SIZE);
+    if (notes_len > RS_SPLAT_MAX_NOTES - 1)
+        return rs_fail(err, RS_ERR_FORMAT, "%s: notes_len: %u bytes, at most %d allowed (byte %d)", name, notes_len,
+                       RS_SPLAT_MAX_NOTES - 1, RSF_OFF_NOTES_LEN);
+    if (header_size != header_size_for(notes_len))
+        return rs_fail(err, RS_ERR_FORMAT, "%s: header_size: %u, expected %zu for %u bytes of notes (byte %d)", name,
+                       header_size, header_size_for(notes_len), notes_len, RSF_OFF_HEADER_SIZE);
+    rs_splat_header *h = calloc(1, sizeof *h);
+    if (!h) return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory", name);
+    rs_rsf_read_fixed_header(b, h);
+    // The notes are not here yet (their own check comes with the whole file): judged as empty.
+    rs_result r = rs_splat_check_header(h, name, true, err);
+    free(h);
+    return r;
+}
+
 rs_result rs_rsf1_load(const uint8_t *b, size_t len, const char *name, rs_splat_cloud **out, rs_error *err)
 {
     rs_splat_header *h = malloc(sizeof *h);

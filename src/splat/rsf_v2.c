@@ -603,6 +603,19 @@ rs_result rs_splat_loader_feed(rs_splat_loader *l, const void *data, size_t len,
     if (l->failed) return rs_fail(err, l->failed, "%s", l->fail_msg);
     const uint8_t *p = data;
     while (len > 0) {
+        if (l->st == LD_V1 && l->have < RSF_OFF_NOTES) {
+            // The fixed header is judged as soon as it is all here, before any record it announces is
+            // buffered (a header claiming 1 GiB of records used to be buffered whole first).
+            size_t take = RS_MIN(len, (size_t)RSF_OFF_NOTES - l->have);
+            if (!ensure_buf(l, l->have + take)) return ld_fail(l, err, RS_ERR_NOMEM, "%s: out of memory", l->name);
+            memcpy(l->buf + l->have, p, take);
+            l->have += take, p += take, len -= take;
+            if (l->have < RSF_OFF_NOTES) return RS_OK;
+            rs_error e = {0};
+            rs_result r = rs_rsf1_check_head(l->buf, l->have, l->name, &e);
+            if (r != RS_OK) return ld_fail(l, err, r, "%s", e.msg);
+            continue;
+        }
         if (l->st == LD_V1) {
             // Kept whole for the v1 loader, up to the length its header announces (the loader judges a
             // shorter file) and the largest file it accepts.

@@ -268,6 +268,16 @@ static rs_result check_frame(const check_ctx *x, const rs_splat_header *h)
     if (fabs(d) > 1e-3) return bad(x, RSF_OFF_UP, "up: not perpendicular to forward (dot %g)", d);
     if (!isfinite(h->face_height) || !(h->face_height > 0.0f))
         return bad(x, RSF_OFF_FACE_HEIGHT, "face_height: %g, must be finite and > 0", h->face_height);
+    // Finite is not enough: the camera frames the face from these, and a centre of 3e38 or a face 1e-30
+    // units tall rendered blank. Both are judged against the box's largest extent (splat_internal.h).
+    double e = bbox_extent(h), far = RS_SPLAT_FACE_EXTENT_MAX * e;
+    for (int a = 0; a < 3; a++)
+        if (!((double)h->centre[a] >= h->bbox_min[a] - far && (double)h->centre[a] <= h->bbox_max[a] + far))
+            return bad(x, RSF_OFF_CENTRE + 4 * (size_t)a, "centre[%d]: %g lies far outside the bounding box %g..%g", a,
+                       h->centre[a], h->bbox_min[a], h->bbox_max[a]);
+    if ((double)h->face_height < RS_SPLAT_FACE_EXTENT_MIN * e || (double)h->face_height > RS_SPLAT_FACE_EXTENT_MAX * e)
+        return bad(x, RSF_OFF_FACE_HEIGHT, "face_height: %g is implausible for a scan %g units across (allowed %g..%g)",
+                   h->face_height, e, RS_SPLAT_FACE_EXTENT_MIN * e, RS_SPLAT_FACE_EXTENT_MAX * e);
     return RS_OK;
 }
 

@@ -73,6 +73,11 @@ static inline size_t rsf_align16(size_t n) { return (n + RSF_PAYLOAD_ALIGN - 1) 
 // radius is at most RADIUS_EXTENT_MAX times the bbox's largest extent E, and the splats' disks together
 // cover at most AREA_MAX * E^2 (real scans: 2-30; 20k whole-model disks once took hours to shadow).
 #define RS_SPLAT_RADIUS_EXTENT_MAX 4.0
+// The face frame against the bounding box's largest extent E (a face-only scan's face height is about
+// 1 E, a bust's 0.5 E): the height within MIN..MAX E, the centre within MAX E of the box. Generous, so
+// any cloud rs_splat_create frames by default passes; what they refuse cannot be framed by a camera.
+#define RS_SPLAT_FACE_EXTENT_MIN 1e-6
+#define RS_SPLAT_FACE_EXTENT_MAX 1e3
 #define RS_SPLAT_AREA_MAX 256.0
 
 // Checks every header field except the payload. `in_file`: errors are RS_ERR_FORMAT and end with
@@ -112,6 +117,10 @@ rs_result rs_splat_decode_all(rs_splat_cloud *c, const char *name, bool in_file,
 
 // Version 1: checks and loads a whole file (rsf_io.c).
 rs_result rs_rsf1_load(const uint8_t *b, size_t len, const char *name, rs_splat_cloud **out, rs_error *err);
+// The fixed part of a version-1 header (its first RSF_OFF_NOTES bytes; RS_OK for fewer or a wrong magic):
+// header size, counts and every field rs_splat_check_header judges, so a stream refuses a bad header
+// before it buffers the records the header announces.
+rs_result rs_rsf1_check_head(const uint8_t *b, size_t len, const char *name, rs_error *err);
 // Version 2 (rsf_v2.c): writes a whole file; loads one (through the progressive loader).
 rs_result rs_rsf2_encode(const rs_splat_cloud *c, const rs_splat_save_desc *d, const char *name, void **out_data,
                          size_t *out_len, rs_error *err);

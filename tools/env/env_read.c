@@ -3,6 +3,7 @@
 
 #include "env/exr_read.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -220,11 +221,32 @@ rs_result rs_envmap_read_memory(const void *data, size_t len, const char *name, 
     else if (len >= 2 && memcmp(b, "#?", 2) == 0) r = read_hdr(b, len, name, max_width, &m, err);
     else return rs_fail(err, RS_ERR_FORMAT, "%s: neither OpenEXR nor Radiance .hdr (by its first bytes)", name);
     if (r != RS_OK) return r;
-    // Negative, NaN or infinite radiance is a broken capture; keep what is usable. 1e9 keeps sums finite.
-    size_t n = (size_t)m.w * m.h * 3;
-    for (size_t i = 0; i < n; i++)
-        if (!(m.rgb[i] >= 0.0f)) m.rgb[i] = 0.0f;
-        else if (m.rgb[i] > 1e9f) m.rgb[i] = 1e9f;
+    // A few negative or NaN texels (a bad pixel) are dropped, denormals flushed to 0 (they made the bake
+    // 4x slower), and 1e9 keeps sums finite. An infinite texel (an overflowed export), or a capture with
+    // no light left (all NaN, negative, zero or denormal: the face rendered black), is refused.
+    size_t n = (size_t)m.w * m.h * 3, nan = 0, inf = 0, neg = 0;
+    float peak = 0.0f;
+    for (size_t i = 0; i < n; i++) {
+        float v = m.rgb[i];
+        if (isnan(v)) nan++, v = 0.0f;
+        else if (isinf(v)) inf++, v = 0.0f;
+        else if (v < 0.0f) neg++, v = 0.0f;
+        else if (v < FLT_MIN) v = 0.0f;
+        else if (v > 1e9f) v = 1e9f;
+        m.rgb[i] = v;
+        peak = fmaxf(peak, v);
+    }
+    const char *why = peak > 0.0f ? NULL
+                      : nan == n ? "NaN"
+                      : neg && neg + nan == n ? "negative (or NaN)"
+                      : "0 or denormal (below 1e-38)";
+    if (inf || why) {
+        free(m.rgb);
+        if (inf)
+            return rs_fail(err, RS_ERR_FORMAT, "%s: %zu of its %zu values are infinite (an overflowed export: re-export "
+                                               "with finite values)", name, inf, n);
+        return rs_fail(err, RS_ERR_FORMAT, "%s: every value is %s: the capture holds no light", name, why);
+    }
     *out = m;
     return RS_OK;
 }

@@ -3,7 +3,8 @@
 //
 // Does: recognise the format by its magic bytes; check the claimed size (width = 2 x height, at most
 // RS_ENVMAP_MAX_WIDTH) before allocating pixels; refuse truncated, damaged or hostile files with one line
-// naming the file; turn negative, NaN and infinite radiance into 0.
+// naming the file; drop a few negative or NaN texels and flush denormals to 0; refuse infinite radiance
+// and captures with no light left (all NaN, negative, zero or denormal), naming the file and the problem.
 // Does not: resample or interpret the map (env_bake.h).
 //
 //   rs_envmap m;

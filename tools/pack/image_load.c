@@ -117,7 +117,7 @@ static bool jpeg_has_end(const uint8_t *d, size_t len)
     return false;
 }
 
-rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs_image *out, rs_error *err)
+static rs_result decode_any(const void *data, size_t len, const char *name, bool quote, rs_image *out, rs_error *err)
 {
     const uint8_t *d = data;
     static const uint8_t png_sig[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
@@ -140,19 +140,37 @@ rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs
         return decode_jpeg(d, len, name, out, err);
     }
     if (len == 0) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file (empty)", name);
+    if (!quote) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file", name);
     char hex[16] = "";
     for (size_t i = 0; i < RS_MIN(len, (size_t)4); i++) snprintf(hex + 3 * i, sizeof hex - 3 * i, "%02x ", d[i]);
     hex[strlen(hex) - 1] = 0;
     return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file (starts %s)", name, hex);
 }
 
-rs_result rs_image_load_any(const char *path, rs_image *out, rs_error *err)
+rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs_image *out, rs_error *err)
+{
+    return decode_any(data, len, name, true, out, err);
+}
+
+// `quote`: the first bytes of a file that is not an image help the user who named it; a file a model
+// names is not the user's, and its bytes must not leak into a message.
+static rs_result load_any(const char *path, bool quote, rs_image *out, rs_error *err)
 {
     void *data;
     size_t len;
     rs_result r = rs_file_read_all(path, RS_IMPORT_MAX_FILE, &data, &len, err);
     if (r != RS_OK) return r;
-    r = rs_image_decode_any(data, len, path, out, err);
+    r = decode_any(data, len, path, quote, out, err);
     free(data);
     return r;
+}
+
+rs_result rs_image_load_any(const char *path, rs_image *out, rs_error *err)
+{
+    return load_any(path, true, out, err);
+}
+
+rs_result rs_image_load_referenced(const char *path, rs_image *out, rs_error *err)
+{
+    return load_any(path, false, out, err);
 }

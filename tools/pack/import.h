@@ -9,7 +9,10 @@
 // by assimp); find each material's base-colour texture (glTF baseColorTexture, MTL map_Kd, also with
 // spaces in the file name, embedded GLB / FBX images) and decode it with size limits checked before the
 // pixels are allocated. Files are opened through our own I/O callbacks: regular files only, size-capped,
-// so an MTL naming a FIFO or /dev/zero cannot hang or exhaust the import.
+// below the model's folder unless allowed (rs_import_desc), so an MTL naming a FIFO, /dev/zero or
+// /etc/passwd cannot hang the import or be read. Hostile structure (deep nesting, nodes that instance
+// themselves, decompression and instancing bombs) is refused before assimp expands it, and assimp runs
+// in a child process with memory and CPU limits (rs_import_load).
 // Does not: sample, convert or write anything (pack.h), or keep animation, bones, cameras or lights.
 //
 //   rs_import_scene *s = NULL;
@@ -29,6 +32,13 @@
 #define RS_IMPORT_MAX_VERTICES (1u << 26)       // after triangulation, before welding
 #define RS_IMPORT_MAX_TRIANGLES (1u << 27)
 #define RS_IMPORT_MAX_PAGES 256                 // materials (texture pages)
+// Before assimp reads a file (import_guard.c): nesting of elements, records and node hierarchies, and
+// the nodes a hierarchy unrolls to when nodes instance others.
+#define RS_IMPORT_MAX_DEPTH 256
+#define RS_IMPORT_MAX_NODES (1u << 20)
+// The import itself runs in a child process (rs_import_load): at most this much address space and CPU.
+#define RS_IMPORT_MAX_MEMORY ((uint64_t)8 << 30)
+#define RS_IMPORT_MAX_CPU_SECONDS 600
 // Texture limits, checked from the image header before any pixel is allocated: a side of at most
 // RS_IMAGE_MAX_DIM and at most 64 Mpx (an 8K x 8K page, 192 MiB as RGB).
 #define RS_IMPORT_MAX_TEXTURE_PIXELS ((uint64_t)8192 * 8192)
@@ -49,7 +59,18 @@ typedef struct rs_import_page {
     char *texture;          // the path as the file names it (relative to the model's folder), or NULL
     const uint8_t *embedded;  // the image file's bytes when the model embeds it (GLB, FBX), or NULL
     size_t embedded_len;
+    uint8_t *embedded_copy;   // what `embedded` points to when the import ran in a child process
 } rs_import_page;
+
+// Options of rs_import_load_with; zero is the default.
+typedef struct rs_import_desc {
+    // Files a model names (MTL, glTF buffers, textures) are read only from the model's folder and below
+    // (after symlinks are resolved): a model cannot make rouge-pack read /etc/passwd or ../../secret.
+    // True allows any path (rouge-pack --allow-outside-paths).
+    bool allow_outside_paths;
+    // Read in this process, without the child process and its limits (tests).
+    bool in_process;
+} rs_import_desc;
 
 typedef struct rs_import_scene {
     rs_ply_mesh *mesh;          // the geometry; mesh->tri_page is set when there is more than one page
@@ -67,17 +88,32 @@ typedef struct rs_import_scene {
     uint32_t page_count;
     rs_import_page *pages;      // page_count entries (NULL when 0)
     uint32_t points_dropped;    // point and line primitives of a mesh that also has triangles
-    void *priv;                 // assimp's scene (embedded images point into it)
+    bool allow_outside_paths;   // from rs_import_desc: textures may come from anywhere
+    void *priv;                 // assimp's scene (embedded images point into it), or NULL
 } rs_import_scene;
 
 // Reads any supported model (see above). Errors: one line naming the file; a file that neither the PLY
-// reader nor assimp can read says which formats are supported.
+// reader nor assimp can read says which formats are supported. A file the model names that is missing
+// (an OBJ's MTL) is a warning in mesh->warnings; one that is not a regular file, or lies outside the
+// model's folder (see rs_import_desc), is an error that names it and never quotes its bytes.
+// Hostile files: rs_import_guard runs first; then assimp reads the file in a child process limited to
+// RS_IMPORT_MAX_MEMORY of address space and RS_IMPORT_MAX_CPU_SECONDS, which flattens the scene and sends
+// the mesh back through a pipe, so a crash (stack overflow) or a memory bomb inside assimp is an error
+// naming the file, not the end of rouge-pack.
 rs_result rs_import_load(const char *path, rs_import_scene **out, rs_error *err);
+rs_result rs_import_load_with(const char *path, const rs_import_desc *desc, rs_import_scene **out, rs_error *err);
 // Same, from memory (the fuzz harness): `hint` is the file extension ("obj", "glb"); materials can name
 // no external files here.
 rs_result rs_import_load_memory(const void *data, size_t len, const char *hint, rs_import_scene **out,
                                 rs_error *err);
 void rs_import_destroy(rs_import_scene *s);
+
+// import_guard.c: checks a model's bytes before assimp reads them, without recursion: nesting of XML
+// elements, JSON containers and FBX records (at most RS_IMPORT_MAX_DEPTH), the node graphs of glTF and
+// COLLADA (no node containing itself, at most RS_IMPORT_MAX_DEPTH deep, unrolling to at most
+// RS_IMPORT_MAX_NODES), and FBX arrays claiming more bytes than their stored bytes can inflate to.
+// RS_ERR_LIMIT / RS_ERR_FORMAT with one line naming `name`; a file it cannot parse passes (assimp refuses it).
+rs_result rs_import_guard(const void *data, size_t len, rs_import_format format, const char *name, rs_error *err);
 const char *rs_import_format_name(rs_import_format f);
 
 // Decodes every page's texture (embedded bytes, or the file named relative to the model's folder) into
@@ -90,6 +126,8 @@ void rs_import_free_pages(rs_image *pages, uint32_t count);
 // the header claims is checked (sides, RS_IMPORT_MAX_TEXTURE_PIXELS, and what the file's bytes can encode)
 // before pixels are allocated. `name` is used in messages.
 rs_result rs_image_load_any(const char *path, rs_image *out, rs_error *err);
+// The same for a file the user did not name (a model's texture): errors never quote its bytes.
+rs_result rs_image_load_referenced(const char *path, rs_image *out, rs_error *err);
 rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs_image *out, rs_error *err);
 
 #endif

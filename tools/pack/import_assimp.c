@@ -5,7 +5,7 @@
 // in, with their materials and node transforms. Why PLY stays ours: ply.c is faster on 600k-point clouds,
 // keeps the `region` property and the header comments (attribution), and has been fuzzed and
 // hardened; assimp's PLY reader drops point clouds' extra properties.
-#define _POSIX_C_SOURCE 200809L
+#define _XOPEN_SOURCE 700  // realpath
 #include "pack/import.h"
 
 #include <assimp/cfileio.h>
@@ -16,12 +16,16 @@
 #include <assimp/scene.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 const char *rs_import_format_name(rs_import_format f)
@@ -38,7 +42,12 @@ typedef struct io_ctx {
     size_t mem_len;
     bool disk;             // other files may be read from disk
     const char *main;      // the model itself: why opening it failed is the error to report
-    char failed[512];
+    rs_import_format format;
+    bool allow_outside;    // files the model names may lie outside its folder
+    char dir[4096];        // the model's folder, symlinks resolved
+    char failed[512];      // why the model itself could not be read, or was refused (rs_import_guard)
+    char refused[512];     // the first file the model names that was refused: an error
+    char missing[512];     // the first file the model names that is not there: a warning
 } io_ctx;
 
 typedef struct io_file {
@@ -89,10 +98,61 @@ static enum aiReturn io_seek(struct aiFile *f, size_t off, enum aiOrigin origin)
     return aiReturn_SUCCESS;
 }
 
+// Whether `path` (which exists) lies in the folder `dir` or below, symlinks resolved.
+static bool inside_folder(const char *dir, const char *path)
+{
+    char real[PATH_MAX];
+    if (!realpath(path, real)) return false;
+    size_t n = strlen(dir);
+    return !strcmp(dir, "/") || (!strncmp(real, dir, n) && real[n] == '/');
+}
+
+// The folder of `path` with symlinks resolved, into dir[cap] ("" when it cannot be resolved).
+static void model_folder(const char *path, char *dir, size_t cap)
+{
+    char real[PATH_MAX];
+    dir[0] = 0;
+    if (!realpath(path, real)) return;
+    char *slash = strrchr(real, '/');
+    if (slash == real) slash[1] = 0;
+    else if (slash) *slash = 0;
+    snprintf(dir, cap, "%s", real);
+}
+
+// A file the model names (an MTL, a glTF buffer): missing is a warning (assimp goes on without it, and
+// the summary says what was lost); outside the model's folder, or not a regular file, is refused.
+static bool io_open_named(io_ctx *c, const char *path, void **data, size_t *len)
+{
+    // assimp's OBJ reader joins the model's folder and an absolute MTL path ("dir//dev/zero"): the file
+    // the model names is the absolute one.
+    const char *abs = strstr(path, "//");
+    if (abs) path = abs + 1;
+    struct stat st;
+    if (stat(path, &st) != 0) {
+        if (!c->missing[0]) snprintf(c->missing, sizeof c->missing, "it names '%s', which is not there (%s)", path, strerror(errno));
+        return false;
+    }
+    if (!c->allow_outside && (!c->dir[0] || !inside_folder(c->dir, path))) {
+        if (!c->refused[0])
+            snprintf(c->refused, sizeof c->refused, "it names '%s', outside the model's folder: not read "
+                                                    "(rouge-pack --allow-outside-paths reads it)", path);
+        return false;
+    }
+    rs_error e = {0};
+    if (rs_file_read_all(path, RS_IMPORT_MAX_FILE, data, len, &e) != RS_OK) {
+        if (!c->refused[0]) snprintf(c->refused, sizeof c->refused, "a file it names: %s", e.msg);
+        return false;
+    }
+    return true;
+}
+
 static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char *mode)
 {
     io_ctx *c = (io_ctx *)io->UserData;
     if (!path || !mode || strchr(mode, 'w') || strchr(mode, 'a') || strchr(mode, '+')) return NULL;
+    bool is_main = c->main && !strcmp(path, c->main);
+    // The model itself, refused once: assimp opens it again to try other readers.
+    if (is_main && c->failed[0]) return NULL;
     io_file *h = calloc(1, sizeof *h);
     struct aiFile *f = calloc(1, sizeof *f);
     if (!h || !f) {
@@ -100,15 +160,25 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char 
         free(f);
         return NULL;
     }
+    rs_error e = {0};
     if (c->mem_name && !strcmp(path, c->mem_name)) {
         h->data = c->mem;
         h->len = c->mem_len;
-    } else if (c->disk) {
-        rs_error e = {0};
+    } else if (c->disk && is_main) {
         void *data;
         size_t len;
         if (rs_file_read_all(path, RS_IMPORT_MAX_FILE, &data, &len, &e) != RS_OK) {
-            if (c->main && !strcmp(path, c->main)) snprintf(c->failed, sizeof c->failed, "%s", e.msg);
+            snprintf(c->failed, sizeof c->failed, "%s", e.msg);
+            free(h);
+            free(f);
+            return NULL;
+        }
+        h->data = h->owned = data;
+        h->len = len;
+    } else if (c->disk) {
+        void *data;
+        size_t len;
+        if (!io_open_named(c, path, &data, &len)) {
             free(h);
             free(f);
             return NULL;
@@ -116,6 +186,14 @@ static struct aiFile *io_open(struct aiFileIO *io, const char *path, const char 
         h->data = h->owned = data;
         h->len = len;
     } else {
+        free(h);
+        free(f);
+        return NULL;
+    }
+    // What assimp would recurse into or inflate without bound is refused before it reads a byte.
+    if (is_main && rs_import_guard(h->data, h->len, c->format, path, &e) != RS_OK) {
+        snprintf(c->failed, sizeof c->failed, "%s", e.msg);
+        free(h->owned);
         free(h);
         free(f);
         return NULL;
@@ -508,10 +586,99 @@ static void collect_comments(const struct aiScene *sc, const uint8_t *head, size
     }
 }
 
+// Before PreTransformVertices copies every mesh once per node that instances it (10^4 nodes instancing
+// one 10^4-triangle mesh become 10^8 triangles, 6.8 GB): the tree is walked without recursion, its depth
+// and the triangles and vertices it unrolls to checked against the limits.
+static rs_result check_unrolled(const struct aiScene *sc, const rs_import_scene *s, rs_error *err)
+{
+    if (!sc->mRootNode) return RS_OK;
+    uint64_t *tris = calloc(sc->mNumMeshes + 1, sizeof *tris);
+    size_t cap = 256, top = 0;
+    struct item {
+        const struct aiNode *node;
+        uint32_t depth;
+    } *stack = malloc(cap * sizeof *stack);
+    if (!tris || !stack) {
+        free(tris), free(stack);
+        return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory", s->path);
+    }
+    for (unsigned i = 0; i < sc->mNumMeshes; i++) {
+        const struct aiMesh *m = sc->mMeshes[i];
+        for (unsigned f = 0; m && m->mFaces && f < m->mNumFaces; f++)
+            tris[i] += m->mFaces[f].mNumIndices >= 3 ? m->mFaces[f].mNumIndices - 2 : 0;
+    }
+    uint64_t nt = 0, nv = 0, nodes = 0;
+    rs_result r = RS_OK;
+    stack[top++] = (struct item){sc->mRootNode, 0};
+    while (top && r == RS_OK) {
+        struct item it = stack[--top];
+        const struct aiNode *n = it.node;
+        if (++nodes > RS_IMPORT_MAX_NODES) {
+            r = rs_fail(err, RS_ERR_LIMIT, "%s: more than %u nodes; not read", s->path, RS_IMPORT_MAX_NODES);
+            break;
+        }
+        if (it.depth > RS_IMPORT_MAX_DEPTH) {
+            r = rs_fail(err, RS_ERR_LIMIT, "%s: nodes nested more than %d deep; not read", s->path, RS_IMPORT_MAX_DEPTH);
+            break;
+        }
+        for (unsigned k = 0; n->mMeshes && k < n->mNumMeshes; k++) {
+            unsigned m = n->mMeshes[k];
+            if (m >= sc->mNumMeshes || !sc->mMeshes[m]) continue;  // ValidateDataStructure refuses it
+            nt += tris[m];
+            nv += sc->mMeshes[m]->mNumVertices;
+        }
+        if (nt > RS_IMPORT_MAX_TRIANGLES || nv > RS_IMPORT_MAX_VERTICES) {
+            r = rs_fail(err, RS_ERR_LIMIT, "%s: its nodes instance meshes to more than %u triangles or %u vertices "
+                                           "(an instancing bomb?); not read", s->path, RS_IMPORT_MAX_TRIANGLES, RS_IMPORT_MAX_VERTICES);
+            break;
+        }
+        for (unsigned k = 0; n->mChildren && k < n->mNumChildren; k++) {
+            if (!n->mChildren[k]) continue;
+            if (top == cap) {
+                void *p = realloc(stack, (cap *= 2) * sizeof *stack);
+                if (!p) {
+                    r = rs_fail(err, RS_ERR_NOMEM, "%s: out of memory", s->path);
+                    break;
+                }
+                stack = p;
+            }
+            stack[top++] = (struct item){n->mChildren[k], it.depth + 1};
+        }
+    }
+    free(tris), free(stack);
+    return r;
+}
+
+// assimp's message for a file it could not read (an exception's text: std::bad_alloc is memory).
+static rs_result assimp_failed(const rs_import_scene *s, rs_error *err)
+{
+    const char *why = aiGetErrorString();
+    if (!why || !*why) why = "unknown error";
+    if (strstr(why, "bad_alloc")) {
+        struct rlimit rl;
+        if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY)
+            return rs_fail(err, RS_ERR_NOMEM, "%s: reading it needs more than the %llu MiB the import may use (a memory "
+                                              "bomb?); not read", s->path, (unsigned long long)(rl.rlim_cur >> 20));
+        return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory reading it; not read", s->path);
+    }
+    if (s->format != RS_IMPORT_OTHER)
+        return rs_fail(err, RS_ERR_FORMAT, "%s: bad %s file (assimp: %s)", s->path, rs_import_format_name(s->format), why);
+    return rs_fail(err, RS_ERR_FORMAT, "%s: not a model rouge-pack can read (PLY, OBJ, glTF/GLB, FBX, STL, DAE and the "
+                                       "other formats assimp reads; assimp: %s)", s->path, why);
+}
+
+// Appends a warning to the mesh's list ("; "-joined, cut to the buffer).
+static void add_warning(rs_ply_mesh *m, const char *w)
+{
+    size_t len = strlen(m->warnings);
+    snprintf(m->warnings + len, sizeof m->warnings - len, "%s%s", len ? "; " : "", w);
+}
+
 static rs_result import_assimp(rs_import_scene *s, io_ctx *ctx, const char *name, const uint8_t *head, size_t head_len,
                                rs_error *err)
 {
     ctx->main = name;
+    ctx->format = s->format;
     struct aiFileIO io = {.OpenProc = io_open, .CloseProc = io_close, .UserData = (aiUserData)ctx};
     struct aiPropertyStore *props = aiCreatePropertyStore();
     if (!props) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
@@ -521,30 +688,51 @@ static rs_result import_assimp(rs_import_scene *s, io_ctx *ctx, const char *name
     aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_FBX_READ_LIGHTS, 0);
     aiSetImportPropertyInteger(props, AI_CONFIG_IMPORT_FBX_READ_WEIGHTS, 0);
     aiSetImportPropertyInteger(props, AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_LINE);
-    unsigned flags = aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_PreTransformVertices |
-                     aiProcess_ValidateDataStructure;
-    const struct aiScene *sc = aiImportFileExWithProperties(name, flags, &io, props);
+    // Read and validated, not yet post-processed: the node tree is checked before anything unrolls it.
+    const struct aiScene *sc = aiImportFileExWithProperties(name, aiProcess_ValidateDataStructure, &io, props);
     aiReleasePropertyStore(props);
     if (!sc) {
-        const char *why = aiGetErrorString();
         if (ctx->failed[0]) return rs_fail(err, RS_ERR_IO, "%s", ctx->failed);
-        if (!why || !*why) why = "unknown error";
-        if (s->format != RS_IMPORT_OTHER)
-            return rs_fail(err, RS_ERR_FORMAT, "%s: bad %s file (assimp: %s)", s->path, rs_import_format_name(s->format), why);
-        return rs_fail(err, RS_ERR_FORMAT, "%s: not a model rouge-pack can read (PLY, OBJ, glTF/GLB, FBX, STL, DAE and the "
-                                           "other formats assimp reads; assimp: %s)", s->path, why);
+        if (ctx->refused[0]) return rs_fail(err, RS_ERR_IO, "%s: %s", s->path, ctx->refused);
+        rs_result r = assimp_failed(s, err);
+        // A missing file it names (a glTF's .bin) is often why.
+        if (ctx->missing[0] && err) {
+            char why[sizeof err->msg];
+            snprintf(why, sizeof why, "%s", err->msg);
+            rs_fail(err, r, "%s; %s", why, ctx->missing);
+        }
+        return r;
     }
+    // A file the model names that was refused is an error even where assimp went on without it.
+    if (ctx->refused[0]) {
+        aiReleaseImport(sc);
+        return rs_fail(err, RS_ERR_IO, "%s: %s", s->path, ctx->refused);
+    }
+    rs_result r = check_unrolled(sc, s, err);
+    if (r != RS_OK) {
+        aiReleaseImport(sc);
+        return r;
+    }
+    // No ValidateDataStructure here: it is the one step that can fail, and assimp 5.2.5's
+    // aiApplyPostProcessing then frees the scene twice (SIGSEGV); the scene was validated on import.
+    sc = aiApplyPostProcessing(sc, aiProcess_Triangulate | aiProcess_SortByPType | aiProcess_PreTransformVertices);
+    if (!sc) return assimp_failed(s, err);
     s->priv = (void *)sc;
     s->v_flipped = s->format == RS_IMPORT_GLTF;
     if (s->format == RS_IMPORT_OTHER) {
         const char *fmt = meta_string(sc->mMetaData, "SourceAsset_Format");
         snprintf(s->format_name, sizeof s->format_name, "%s", fmt && *fmt ? fmt : "model");
     }
-    rs_result r = flatten(sc, s, err);
+    r = flatten(sc, s, err);
     if (r == RS_OK) r = collect_pages(sc, s, err);
     if (r != RS_OK) return r;
     declared_unit(sc, s);
     collect_comments(sc, head, head_len, s);
+    if (ctx->missing[0]) {
+        char w[sizeof ctx->missing + 64];
+        snprintf(w, sizeof w, "%s; converted without it", ctx->missing);
+        add_warning(s->mesh, w);
+    }
     return RS_OK;
 }
 
@@ -555,8 +743,254 @@ static rs_import_scene *scene_new(const char *path)
     return s;
 }
 
+// ---- the import in a child process ----
+//
+// Why: the checks before assimp (import_guard.c) see the known hostile shapes in the formats people use;
+// assimp reads forty more, and what it does on a crafted file is not ours to fix. So assimp reads the file
+// in a forked child limited to RS_IMPORT_MAX_MEMORY of address space and RS_IMPORT_MAX_CPU_SECONDS; the
+// child flattens the scene and writes the mesh and texture pages to a pipe. A stack overflow, a memory
+// bomb or an endless loop then ends the child, and the parent reports it as one line naming the file.
+// Lower limits a shell sets (ulimit -v) are kept. PLY stays in the process: ply.c is rouge's own.
+
+#define WIRE_MAGIC 0x52534931u  // "RSI1"
+
+// AddressSanitizer reserves terabytes of address space for its shadow: under it an address-space limit
+// would fail every allocation, so `make asan` runs the child without one (the other limits stay).
+#if defined(__SANITIZE_ADDRESS__)
+#define RS_IMPORT_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define RS_IMPORT_ASAN 1
+#endif
+#endif
+#ifndef RS_IMPORT_ASAN
+#define RS_IMPORT_ASAN 0
+#endif
+
+typedef struct wire_head {
+    uint32_t magic;
+    rs_result result;
+    char msg[sizeof ((rs_error *)0)->msg];
+    rs_import_format format;
+    char format_name[64];
+    float declared_mm_per_unit;
+    char unit_source[96];
+    bool v_flipped, normal, uv, rgb, tri_page;
+    uint32_t page_count, points_dropped, vertex_count, tri_count;
+    uint32_t comments_len;
+    char warnings[512];
+} wire_head;
+
+typedef struct wire_page {
+    char name[64];
+    uint32_t texture_len;
+    uint64_t embedded_len;
+} wire_page;
+
+static bool put(int fd, const void *p, size_t n)
+{
+    const uint8_t *b = p;
+    while (n) {
+        ssize_t w = write(fd, b, n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return false;
+        b += w, n -= (size_t)w;
+    }
+    return true;
+}
+
+static bool get(int fd, void *p, size_t n)
+{
+    uint8_t *b = p;
+    while (n) {
+        ssize_t r = read(fd, b, n);
+        if (r < 0 && errno == EINTR) continue;
+        if (r <= 0) return false;
+        b += r, n -= (size_t)r;
+    }
+    return true;
+}
+
+static bool send_scene(int fd, rs_result result, const rs_error *e, const rs_import_scene *s)
+{
+    wire_head h;
+    memset(&h, 0, sizeof h);  // padding too: every byte that goes down the pipe is defined
+    h.magic = WIRE_MAGIC, h.result = result;
+    if (result != RS_OK) {
+        snprintf(h.msg, sizeof h.msg, "%s", e->msg);
+        return put(fd, &h, sizeof h);
+    }
+    const rs_ply_mesh *m = s->mesh;
+    h.format = s->format;
+    memcpy(h.format_name, s->format_name, sizeof h.format_name);
+    h.declared_mm_per_unit = s->declared_mm_per_unit;
+    memcpy(h.unit_source, s->unit_source, sizeof h.unit_source);
+    h.v_flipped = s->v_flipped, h.normal = m->normal, h.uv = m->uv, h.rgb = m->rgb, h.tri_page = m->tri_page;
+    h.page_count = s->page_count, h.points_dropped = s->points_dropped;
+    h.vertex_count = m->vertex_count, h.tri_count = m->tri_count;
+    h.comments_len = (uint32_t)strlen(m->comments);
+    memcpy(h.warnings, m->warnings, sizeof h.warnings);
+    size_t nv = m->vertex_count, nt = m->tri_count;
+    bool ok = put(fd, &h, sizeof h) && put(fd, m->pos, nv * sizeof *m->pos) &&
+              (!m->normal || put(fd, m->normal, nv * sizeof *m->normal)) && (!m->uv || put(fd, m->uv, nv * sizeof *m->uv)) &&
+              (!m->rgb || put(fd, m->rgb, nv * sizeof *m->rgb)) && (!m->tri || put(fd, m->tri, nt * sizeof *m->tri)) &&
+              (!m->tri_page || put(fd, m->tri_page, nt * sizeof *m->tri_page)) && put(fd, m->comments, h.comments_len);
+    for (uint32_t i = 0; ok && i < s->page_count; i++) {
+        const rs_import_page *p = &s->pages[i];
+        wire_page w = {.texture_len = p->texture ? (uint32_t)strlen(p->texture) : 0, .embedded_len = p->embedded_len};
+        memcpy(w.name, p->name, sizeof w.name);
+        ok = put(fd, &w, sizeof w) && put(fd, p->texture, w.texture_len) && (!p->embedded || put(fd, p->embedded, p->embedded_len));
+    }
+    return ok;
+}
+
+static void *get_array(int fd, bool want, size_t count, size_t size, bool *ok)
+{
+    if (!want || !*ok) return NULL;
+    void *p = rs_alloc_array(count ? count : 1, size);
+    *ok = p && get(fd, p, count * size);
+    return p;
+}
+
+// The child's scene into s; false when the pipe ended early (the child died: the caller says why).
+static bool receive_scene(int fd, rs_import_scene *s, rs_result *result, rs_error *err)
+{
+    wire_head h;
+    if (!get(fd, &h, sizeof h) || h.magic != WIRE_MAGIC) return false;
+    h.msg[sizeof h.msg - 1] = h.format_name[63] = h.unit_source[95] = h.warnings[511] = 0;
+    if (h.result != RS_OK) {
+        // Already made terminal-safe in the child.
+        if (err) err->code = h.result, snprintf(err->msg, sizeof err->msg, "%s", h.msg);
+        *result = h.result;
+        return true;
+    }
+    if (h.vertex_count > RS_IMPORT_MAX_VERTICES || h.tri_count > RS_IMPORT_MAX_TRIANGLES ||
+        h.page_count > RS_IMPORT_MAX_PAGES || h.comments_len > (1u << 20) || h.format > RS_IMPORT_OTHER)
+        return false;
+    s->format = h.format;
+    memcpy(s->format_name, h.format_name, sizeof s->format_name);
+    s->declared_mm_per_unit = h.declared_mm_per_unit;
+    memcpy(s->unit_source, h.unit_source, sizeof s->unit_source);
+    s->v_flipped = h.v_flipped, s->points_dropped = h.points_dropped;
+    rs_ply_mesh *m = calloc(1, sizeof *m);
+    if (!m) return false;
+    s->mesh = m;
+    size_t nv = h.vertex_count, nt = h.tri_count;
+    bool ok = true;
+    m->vertex_count = h.vertex_count, m->tri_count = h.tri_count;
+    m->pos = get_array(fd, true, nv, sizeof *m->pos, &ok);
+    m->normal = get_array(fd, h.normal, nv, sizeof *m->normal, &ok);
+    m->uv = get_array(fd, h.uv, nv, sizeof *m->uv, &ok);
+    m->rgb = get_array(fd, h.rgb, nv, sizeof *m->rgb, &ok);
+    m->tri = get_array(fd, nt > 0, nt, sizeof *m->tri, &ok);
+    m->tri_page = get_array(fd, h.tri_page, nt, sizeof *m->tri_page, &ok);
+    m->comments = ok ? calloc(h.comments_len + 1, 1) : NULL;
+    if (!m->comments || !get(fd, m->comments, h.comments_len)) return false;
+    memcpy(m->warnings, h.warnings, sizeof m->warnings);
+    // Indices are checked again: the child is ours, but a mesh with a bad index must not reach the sampler.
+    for (size_t t = 0; t < nt; t++)
+        for (int c = 0; c < 3; c++)
+            if (m->tri[t][c] >= nv) return false;
+    if (h.page_count) {
+        s->pages = calloc(h.page_count, sizeof *s->pages);
+        if (!s->pages) return false;
+        s->page_count = h.page_count;
+    }
+    for (uint32_t i = 0; i < h.page_count; i++) {
+        rs_import_page *p = &s->pages[i];
+        wire_page w;
+        if (!get(fd, &w, sizeof w) || w.texture_len > 4096 || w.embedded_len > RS_IMPORT_MAX_FILE) return false;
+        memcpy(p->name, w.name, sizeof p->name);
+        p->name[sizeof p->name - 1] = 0;
+        if (w.texture_len) {
+            p->texture = calloc(w.texture_len + 1, 1);
+            if (!p->texture || !get(fd, p->texture, w.texture_len)) return false;
+        }
+        if (w.embedded_len) {
+            p->embedded_copy = malloc(w.embedded_len);
+            if (!p->embedded_copy || !get(fd, p->embedded_copy, w.embedded_len)) return false;
+            p->embedded = p->embedded_copy;
+            p->embedded_len = w.embedded_len;
+        }
+    }
+    *result = RS_OK;
+    return true;
+}
+
+static void set_limit(int resource, rlim_t soft, rlim_t hard)
+{
+    struct rlimit rl;
+    if (getrlimit(resource, &rl) != 0) return;
+    // Only ever lowered: a limit the shell set stays.
+    if (rl.rlim_max != RLIM_INFINITY && hard > rl.rlim_max) hard = rl.rlim_max;
+    if (rl.rlim_cur != RLIM_INFINITY && soft > rl.rlim_cur) soft = rl.rlim_cur;
+    rl.rlim_cur = RS_MIN(soft, hard), rl.rlim_max = hard;
+    setrlimit(resource, &rl);
+}
+
+static rs_result import_file(const char *path, const rs_import_desc *desc, const uint8_t *head, size_t head_len,
+                             rs_import_scene *s, rs_error *err)
+{
+    io_ctx ctx = {.disk = true, .allow_outside = desc->allow_outside_paths};
+    model_folder(path, ctx.dir, sizeof ctx.dir);
+    return import_assimp(s, &ctx, path, head, head_len, err);
+}
+
+static rs_result import_in_child(const char *path, const rs_import_desc *desc, const uint8_t *head, size_t head_len,
+                                 rs_import_scene *s, rs_error *err)
+{
+    int fds[2];
+    if (pipe(fds) != 0) return rs_fail(err, RS_ERR_IO, "%s: cannot start the import: %s", path, strerror(errno));
+    pid_t pid = fork();
+    if (pid < 0) {
+        close(fds[0]), close(fds[1]);
+        return rs_fail(err, RS_ERR_IO, "%s: cannot start the import: %s", path, strerror(errno));
+    }
+    if (pid == 0) {
+        close(fds[0]);
+        if (!RS_IMPORT_ASAN) set_limit(RLIMIT_AS, RS_IMPORT_MAX_MEMORY, RS_IMPORT_MAX_MEMORY);
+        set_limit(RLIMIT_CPU, RS_IMPORT_MAX_CPU_SECONDS, RS_IMPORT_MAX_CPU_SECONDS + 5);
+        set_limit(RLIMIT_CORE, 0, 0);
+        rs_error e = {0};
+        rs_result r = import_file(path, desc, head, head_len, s, &e);
+        // _exit: the parent's stdio buffers and atexit handlers are the parent's.
+        _exit(send_scene(fds[1], r, &e, s) ? 0 : 3);
+    }
+    close(fds[1]);
+    rs_result result = RS_ERR_IO;
+    bool got = receive_scene(fds[0], s, &result, err);
+    close(fds[0]);
+    // A child still writing what the parent refused to read is stopped, not waited for.
+    if (!got) kill(pid, SIGKILL);
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {}
+    if (got) return result;
+    if (WIFSIGNALED(status)) {
+        int sig = WTERMSIG(status);
+        if (sig == SIGSEGV || sig == SIGBUS)
+            return rs_fail(err, RS_ERR_FORMAT, "%s: assimp crashed reading it (signal %d, %s: most likely a stack overflow on "
+                                               "nodes nested too deeply or a node that contains itself); not read",
+                           path, sig, sig == SIGSEGV ? "SIGSEGV" : "SIGBUS");
+        if (sig == SIGXCPU)
+            return rs_fail(err, RS_ERR_LIMIT, "%s: reading it took more than %d s of CPU time (a work bomb?); not read", path,
+                           RS_IMPORT_MAX_CPU_SECONDS);
+        if (sig == SIGABRT)
+            return rs_fail(err, RS_ERR_NOMEM, "%s: assimp aborted reading it (out of memory or a failed check); not read", path);
+        return rs_fail(err, RS_ERR_IO, "%s: the import was stopped by signal %d (%s); not read", path, sig, strsignal(sig));
+    }
+    return rs_fail(err, RS_ERR_IO, "%s: the import process failed (exit %d); not read", path,
+                   WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+}
+
 rs_result rs_import_load(const char *path, rs_import_scene **out, rs_error *err)
 {
+    return rs_import_load_with(path, NULL, out, err);
+}
+
+rs_result rs_import_load_with(const char *path, const rs_import_desc *desc, rs_import_scene **out, rs_error *err)
+{
+    static const rs_import_desc defaults;
+    if (!desc) desc = &defaults;
     // The head of the file, read non-blocking from a regular file only (a FIFO would block the read).
     int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
     if (fd < 0) return rs_fail(err, RS_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
@@ -572,6 +1006,7 @@ rs_result rs_import_load(const char *path, rs_import_scene **out, rs_error *err)
     const char *ext = ext_of(path);
     rs_import_scene *s = scene_new(path);
     if (!s) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    s->allow_outside_paths = desc->allow_outside_paths;
     rs_result r;
     if (is_ply_magic(head, (size_t)got) || !strcasecmp(ext, "ply")) {
         s->format = RS_IMPORT_PLY;
@@ -580,8 +1015,8 @@ rs_result rs_import_load(const char *path, rs_import_scene **out, rs_error *err)
         r = rs_fail(err, RS_ERR_FORMAT, "%s: file is empty", path);
     } else {
         s->format = sniff(head, (size_t)got, ext);
-        io_ctx ctx = {.disk = true};
-        r = import_assimp(s, &ctx, path, head, (size_t)got, err);
+        r = desc->in_process ? import_file(path, desc, head, (size_t)got, s, err)
+                             : import_in_child(path, desc, head, (size_t)got, s, err);
     }
     if (!s->format_name[0]) snprintf(s->format_name, sizeof s->format_name, "%s", rs_import_format_name(s->format));
     if (r != RS_OK) {
@@ -622,7 +1057,10 @@ void rs_import_destroy(rs_import_scene *s)
 {
     if (!s) return;
     rs_ply_destroy(s->mesh);
-    for (uint32_t i = 0; i < s->page_count && s->pages; i++) free(s->pages[i].texture);
+    for (uint32_t i = 0; i < s->page_count && s->pages; i++) {
+        free(s->pages[i].texture);
+        free(s->pages[i].embedded_copy);
+    }
     free(s->pages);
     if (s->priv) aiReleaseImport(s->priv);
     free(s);
@@ -632,7 +1070,8 @@ void rs_import_destroy(rs_import_scene *s)
 
 // A texture path from a material: relative to the model's folder; Windows separators are accepted, and
 // when the path does not exist (an absolute path from the machine that made the file) the bare file name
-// next to the model is tried.
+// next to the model is tried. A path outside the model's folder is not read unless the scene allows it
+// (rs_import_desc): the bare name in the folder is tried instead; errors never quote the file's bytes.
 static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *p, rs_image *out, rs_error *err)
 {
     char rel[1024];
@@ -644,15 +1083,22 @@ static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *
     char *slash = strrchr(dir, '/');
     if (slash) slash[1] = 0;
     else dir[0] = 0;
+    char folder[4096];
+    model_folder(s->path, folder, sizeof folder);
     char full[8192];
     const char *base = strrchr(rel, '/') ? strrchr(rel, '/') + 1 : rel;
     const char *tries[2] = {rel, base};
+    bool outside = false;
     for (int k = 0; k < 2; k++) {
         if (tries[k][0] == '/') snprintf(full, sizeof full, "%s", tries[k]);
         else snprintf(full, sizeof full, "%s%s", dir, tries[k]);
         struct stat st;
         if (stat(full, &st) != 0) continue;
-        rs_result r = rs_image_load_any(full, out, err);
+        if (!s->allow_outside_paths && (!folder[0] || !inside_folder(folder, full))) {
+            outside = true;
+            continue;
+        }
+        rs_result r = rs_image_load_referenced(full, out, err);
         if (r != RS_OK) {
             char why[sizeof err->msg];
             snprintf(why, sizeof why, "%s", err->msg);
@@ -660,6 +1106,10 @@ static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *
         }
         return RS_OK;
     }
+    if (outside)
+        return rs_fail(err, RS_ERR_IO, "%s: material '%s' names the texture '%s', outside the model's folder: not read "
+                                       "(rouge-pack --allow-outside-paths reads it, --texture FILE uses another image)",
+                       s->path, p->name, p->texture);
     return rs_fail(err, RS_ERR_IO, "%s: material '%s' names the texture '%s', which is not there (looked in '%s'); "
                                    "pass --texture FILE to use another image", s->path, p->name, p->texture, dir[0] ? dir : "./");
 }
