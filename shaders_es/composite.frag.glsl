@@ -4,7 +4,8 @@
 // shadowed key light, the unshadowed fill, the environment's prefiltered radiance), reads the diffuse D
 // of stage 4, and composes F = A (D + S) (paper eq. 1) or F = A D + S, then adds the makeup's untinted
 // clear coat and its flakes; then exposure, the filmic curve (or a clamp) and the sRGB encoding. Also the
-// debug views (render.h rs_render_mode).
+// debug views (render.h rs_render_mode). The makeup's fine layer (narrow brushes) is composed here per
+// pixel, over the splat layer's A, m, rho_s, coat and flakes (makeup_fine.glsl).
 precision highp float;
 precision highp int;
 #define RS_NEEDS_VISIBLE_POINT 1
@@ -12,6 +13,7 @@ precision highp int;
 #include "shadow_lookup.glsl"
 #include "skin_brdf.glsl"
 #include "env_light.glsl"
+#include "makeup_fine.glsl"
 
 // Same numbering as rs_render_mode in render.h.
 #define MODE_FULL 0
@@ -203,13 +205,15 @@ void main()
     vec3 N, debug = vec3(0.0);
     N = normalize(t1.xyz * inv * 2.0 - 1.0);
     float m = t1.a * inv;
-    float rho_s = t2.r * inv * u_rho_s_scale;
+    float rho_s = t2.r * inv;
     debug = t2.gba * inv;       // the debug views' colour, else (ambient occlusion, coat, flakes)
     float ao = debug.x, coat = debug.y, shimmer = debug.z;
     vec3 V = normalize(-p);
 
     if (u_mode == MODE_NORMALS) { o_color = vec4(N * 0.5 + 0.5, 1.0); return; }
     if (u_mode == MODE_REGIONS || u_mode == MODE_LOD) { o_color = vec4(debug, 1.0); return; }
+    rs_fine_apply((u_inv_view * vec4(p, 1.0)).xyz, normalize(mat3(u_inv_view) * N), A, m, rho_s, coat, shimmer);
+    rho_s *= u_rho_s_scale;
     float shadow = rs_shadow(p, N);
     if (u_mode == MODE_SHADOW) { o_color = vec4(vec3(shadow), 1.0); return; }
 

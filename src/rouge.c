@@ -165,6 +165,8 @@ struct rouge_face {
     rec_writer *writer;           // writes it to its file off the pointer path
     uint32_t uploaded;            // records uploaded for the last frame
     rs_makeup *cmp;               // the compared look (rouge_face_set_compare_look), NULL = bare
+    uint32_t fine_version;        // the painted layer's fine stamps the renderer holds (rs_makeup_fine_version)
+    bool fine_other;              // the renderer holds another layer's fine stamps (the compared look's)
     uintptr_t context;            // the GL context the face was created in (its objects live there)
     uint32_t host_gl_error;       // the first GL error a host left pending (rouge_face_take_host_gl_error)
     bool have_source;             // loaded from a file: never overwrite it
@@ -873,6 +875,27 @@ static rs_result flush_makeup(rouge_face *f, rs_error *e)
     return RS_OK;
 }
 
+// Hands the renderer `mk`'s fine layer (the per-pixel stamps).
+static rs_result upload_fine(rouge_face *f, const rs_makeup *mk, rs_error *e)
+{
+    rs_makeup_fine_stamp *s = NULL;
+    uint32_t n = 0;
+    rs_result r = rs_makeup_fine_stamps(mk, &s, &n, e);
+    if (!r) r = rs_render_update_fine(f->ren, s, n, mk, e);
+    free(s);
+    return r;
+}
+
+// The painted layer's fine stamps, when they changed since the renderer last had them.
+static rs_result flush_fine(rouge_face *f, rs_error *e)
+{
+    uint32_t v = rs_makeup_fine_version(f->mk);
+    if (!f->fine_other && v == f->fine_version) return RS_OK;
+    rs_result r = upload_fine(f, f->mk, e);
+    if (!r) f->fine_version = v, f->fine_other = false;
+    return r;
+}
+
 // GL state is saved by the caller.
 static rs_result render_at(rouge_face *f, int w, int h, rs_error *e)
 {
@@ -880,6 +903,7 @@ static rs_result render_at(rouge_face *f, int w, int h, rs_error *e)
         return rs_fail(e, RS_ERR_LIMIT, "frame %dx%d is over the %d pixel limit (set view.width and height)", w, h,
                        RS_VIEW_MAX_SIZE_PX);
     rs_result r = flush_makeup(f, e);
+    if (!r) r = flush_fine(f, e);
     rs_view v = to_rs_view(&f->view, w, h);
     if (!r && f->view.compare_look && f->cmp) {
         // The renderer holds one makeup layer: the compared look's for this frame, then the painted one's
@@ -887,10 +911,13 @@ static rs_result render_at(rouge_face *f, int w, int h, rs_error *e)
         uint32_t n = rs_makeup_count(f->mk);
         rs_render_invalidate(f->ren);
         r = rs_render_update_makeup(f->ren, 0, n, rs_makeup_records(f->cmp), e);
+        f->fine_other = true;
+        if (!r) r = upload_fine(f, f->cmp, e);
         if (!r) r = rs_render_frame(f->ren, &v, e);
         rs_render_invalidate(f->ren);
         rs_error e2 = {0};
         rs_result r2 = rs_render_update_makeup(f->ren, 0, n, rs_makeup_records(f->mk), &e2);
+        if (!r2) r2 = flush_fine(f, &e2);
         if (!r && r2) r = r2, *e = e2;
     } else {
         if (f->view.compare_look) v.hide_makeup = true;  // no look to compare with: the bare face

@@ -72,6 +72,16 @@ static const rs_cosmetic presets[] = {
     // fine hard line; a matte gel liner (a glossy one mirrors the softboxes as a grey streak along it).
     {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.38f, 0.10f, 0.02f, 1.00f,
      0.0f, 0.0f, 1.00f, RS_COSMETIC_REGION_EYES},
+    // Brow pencil: taupe brown, fine (a 2 mm tip: hair-like strokes along the brow), semi-opaque, matte.
+    // Any region: the brows are their own region in a scan, or none.
+    {"brow_pencil", RS_COSMETIC_BROW, {92, 70, 56}, 0.80f, 1.00f, 0.80f, 0.40f, 0.10f, 0.018f, 0.80f,
+     0.0f, 0.0f, 0.70f, RS_COSMETIC_REGION_ANY},
+    // Mascara: black, opaque, a short crisp band on the upper lash line with a faint wet sheen.
+    {"mascara", RS_COSMETIC_MASCARA, {16, 14, 14}, 0.95f, 1.00f, 1.00f, 0.30f, 0.20f, 0.015f, 1.00f,
+     0.0f, 0.0f, 1.00f, RS_COSMETIC_REGION_EYES},
+    // Concealer: light, neutral-warm, high coverage on a small brush; matte like foundation.
+    {"concealer", RS_COSMETIC_CONCEALER, {226, 190, 164}, 0.75f, 1.00f, 0.70f, 0.36f, 0.13f, 0.05f, 0.70f,
+     0.0f, 0.0f, 0.75f, RS_COSMETIC_REGION_SKIN},
 };
 
 uint32_t rs_cosmetic_count(void) { return (uint32_t)RS_COUNT_OF(presets); }
@@ -90,7 +100,7 @@ const char *rs_cosmetic_kind_name(rs_cosmetic_kind kind)
 {
     static const char *names[RS_COSMETIC_KIND_COUNT] = {
         "custom", "foundation", "powder", "blush", "bronzer", "highlighter", "lipstick", "lip_gloss",
-        "eyeshadow", "eyeliner",
+        "eyeshadow", "eyeliner", "brow", "mascara", "concealer",
     };
     return (unsigned)kind < RS_COSMETIC_KIND_COUNT ? names[kind] : "unknown";
 }
@@ -105,6 +115,7 @@ rs_cosmetic_region rs_cosmetic_region_of(const rs_cosmetic *c)
     case RS_COSMETIC_LIPSTICK:
     case RS_COSMETIC_LIP_GLOSS: return RS_COSMETIC_REGION_LIPS;
     case RS_COSMETIC_EYESHADOW:
+    case RS_COSMETIC_MASCARA:
     case RS_COSMETIC_EYELINER: return RS_COSMETIC_REGION_EYES;
     case RS_COSMETIC_CUSTOM: return RS_COSMETIC_REGION_ANY;
     default: return RS_COSMETIC_REGION_SKIN;  // base, powder, blush, bronzer, highlighter

@@ -1,7 +1,7 @@
 // cosmetics.h — the products a person paints with: colour, material weight and finish per cosmetic.
 //
 // Does: a fixed table of presets (foundation shades 1/2/3, powder, blush, bronzer, contour, highlighter,
-// lipsticks, lip gloss, eyeshadows, eyeliner), looked up by name or listed for a UI; custom products from
+// lipsticks, lip gloss, eyeshadows, eyeliner, brow pencil, mascara, concealer), looked up by name or listed for a UI; custom products from
 // an RGB or HSV colour and a custom finish; validation of a cosmetic's fields (for files that carry one).
 // Does not: paint (src/makeup/makeup.c applies a cosmetic to the layer) or own any state: presets are static
 // constants, customs are plain values the caller keeps.
@@ -31,6 +31,9 @@ typedef enum rs_cosmetic_kind {
     RS_COSMETIC_LIP_GLOSS,
     RS_COSMETIC_EYESHADOW,
     RS_COSMETIC_EYELINER,
+    RS_COSMETIC_BROW,         // brow pencil: fine hair-like strokes
+    RS_COSMETIC_MASCARA,      // along the lash line: a crisp, very dark band
+    RS_COSMETIC_CONCEALER,    // opaque, skin-toned, small brush: covers spots and under-eye shadow
     RS_COSMETIC_KIND_COUNT,
 } rs_cosmetic_kind;
 

@@ -38,6 +38,15 @@
 //   pigment varies about its clamped value exactly as much as the skin varied about its local mean.
 //   Then eq. (2) mixes it in. The detail ratio rides in the record's flags byte (q/128), computed once
 //   per cloud here, so the shader needs no neighbourhood.
+//
+// * Two resolutions. A splat record samples a stamp at the splat's centre, and the attribute pass
+//   blends records with the splats' Gaussian filter (~1-2 mm on the bundled head): exact enough for a
+//   brush many splats wide (its falloff is smooth on that scale), but a liner 2 mm wide becomes a lumpy,
+//   blurred chain of splats. So stamps of a brush narrower than RS_MAKEUP_FINE_RADIUS_MM are the *fine
+//   layer*: they are logged but change no record; the renderer evaluates them per pixel at the surface
+//   point the pixel sees (shaders_es/makeup_fine.glsl: the same eqs. 2-3, stroke max, I_F and stacking
+//   as here, over the splat layer). Erasers change both. A fine stamp ignores the region mask (a pencil is
+//   its own mask) and keeps no skin-detail ratio (its pigment is flat).
 #include "makeup/makeup.h"
 #include "core/image.h"
 
@@ -110,6 +119,8 @@ struct rs_makeup {
     uint32_t *order;  // splat indices grouped by cell
 
     bool in_stroke;
+    bool stroke_fine;      // the open stroke holds fine stamps (it changes the picture without records)
+    uint32_t fine_version; // rs_makeup_fine_version
     bool stroke_reserved;  // a log stroke slot exists for the open stroke
     uint32_t stroke_first_stamp;
     int32_t *slot_of;
@@ -218,20 +229,38 @@ float rs_makeup_pressure_scale(rs_makeup_pressure map, float pressure)
     }
 }
 
-// I_G from the squared distance ratio t = d^2 / r^2.
-static float falloff_t(float t)
+// I_G from the squared distance ratio t = d^2 / r^2, for a tip of hardness `hard` (0 = Gaussian).
+static float falloff_t(float t, float hard)
 {
     if (!(t < 1.0f)) return 0.0f;
+    if (hard > 0.0f) {
+        float x = RS_CLAMP((1.0f - sqrtf(t)) / (1.0f - hard), 0.0f, 1.0f);
+        return x * x * (3.0f - 2.0f * x);
+    }
     const float k = 1.0f / (2.0f * RS_MAKEUP_SIGMA_REL * RS_MAKEUP_SIGMA_REL);
     const float rim = expf(-k);
     return (expf(-k * t) - rim) / (1.0f - rim);
 }
 
-float rs_makeup_falloff(float dist, float radius)
+float rs_makeup_tip_falloff(float dist, float radius, float hardness)
 {
     if (!(radius > 0.0f)) return 0.0f;
     float u = dist / radius;
-    return falloff_t(u * u);
+    return falloff_t(u * u, RS_CLAMP(hardness, 0.0f, 0.95f));
+}
+
+float rs_makeup_falloff(float dist, float radius) { return rs_makeup_tip_falloff(dist, radius, 0.0f); }
+
+float rs_makeup_tip_hardness(const rs_cosmetic *c)
+{
+    // A liquid liner or a mascara wand leaves a crisp edge (~0.2 mm on a 2 mm line); a brow pencil a
+    // slightly softer one. Everything else is a blending brush.
+    switch (c->kind) {
+    case RS_COSMETIC_EYELINER: return 0.8f;
+    case RS_COSMETIC_MASCARA: return 0.8f;
+    case RS_COSMETIC_BROW: return 0.6f;
+    default: return 0.0f;
+    }
 }
 
 float rs_makeup_touch_weight(uint32_t touches) { return 1.0f - expf(-(float)touches / RS_MAKEUP_TOUCH_K); }
@@ -262,14 +291,15 @@ static uint8_t to_srgb8(const colour_tables *t, float x)
 
 // A cosmetic prepared for composing: colour in linear light, weights clamped.
 typedef struct prepared {
-    float lin[3], colour_w, finish_w, m, rho_s, material_w, coat, shimmer, coverage;
+    float lin[3], colour_w, finish_w, m, rho_s, material_w, coat, shimmer, coverage, hard;
 } prepared;
 
 static prepared prepare(const colour_tables *t, const rs_cosmetic *c)
 {
     prepared p = {{t->to_lin[c->rgb[0]], t->to_lin[c->rgb[1]], t->to_lin[c->rgb[2]]},
                   clamp01(c->colour_weight), clamp01(c->finish_weight), clamp01(c->m), clamp01(c->rho_s),
-                  clamp01(c->material_weight), clamp01(c->coat), clamp01(c->shimmer), clamp01(c->coverage)};
+                  clamp01(c->material_weight), clamp01(c->coat), clamp01(c->shimmer), clamp01(c->coverage),
+                  rs_makeup_tip_hardness(c)};
     return p;
 }
 
@@ -906,6 +936,80 @@ static uint32_t sum_cell_counts(const rs_makeup *mk, const float p[3], float r)
     return (uint32_t)RS_MIN(sum, (uint64_t)mk->n);
 }
 
+// --- the fine layer --------------------------------------------------------------------------------
+
+bool rs_makeup_is_fine(const rs_makeup *mk, float radius)
+{
+    float mm = mk->cloud->hdr.mm_per_unit > 0.0f ? mk->cloud->hdr.mm_per_unit : 1.0f;
+    return radius * mm < RS_MAKEUP_FINE_RADIUS_MM;
+}
+
+uint32_t rs_makeup_fine_version(const rs_makeup *mk) { return mk->fine_version; }
+
+typedef struct plane_ctx {
+    const rs_makeup *mk;
+    const float *p;
+    float inv_2s2, r2;
+    double w, c[3], n[3];
+} plane_ctx;
+
+static bool plane_cell(void *user, const grid_cell *gc)
+{
+    plane_ctx *x = user;
+    for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
+        uint32_t i = x->mk->order[k];
+        float d2 = dist2(x->mk->cloud->pos[i], x->p);
+        if (!(d2 < x->r2)) continue;
+        double g = exp(-(double)d2 * x->inv_2s2);
+        x->w += g;
+        for (int a = 0; a < 3; a++) x->c[a] += g * x->mk->cloud->pos[i][a], x->n[a] += g * x->mk->cloud->normal[i][a];
+    }
+    return true;
+}
+
+// p moved onto the surface: the plane of the splats around it (Gaussian-weighted centre and normal over
+// `reach`). A fine stamp's mirror image snapped to the nearest splat would jitter by half the splat
+// spacing from stamp to stamp (a mirrored liner broke into dots); the plane moves smoothly with p.
+static bool surface_point(const rs_makeup *mk, const float p[3], float reach, float out[3])
+{
+    plane_ctx x = {mk, p, 1.0f / (0.5f * reach * reach), reach * reach, 0, {0, 0, 0}, {0, 0, 0}};
+    for_cells(mk, p, reach, plane_cell, &x, NULL);
+    double len = sqrt(x.n[0] * x.n[0] + x.n[1] * x.n[1] + x.n[2] * x.n[2]);
+    if (!(x.w > 0) || !(len > 0)) return false;
+    double d = 0;
+    for (int a = 0; a < 3; a++) d += (p[a] - x.c[a] / x.w) * x.n[a] / len;
+    for (int a = 0; a < 3; a++) out[a] = (float)(p[a] - d * x.n[a] / len);
+    return true;
+}
+
+rs_result rs_makeup_fine_stamps(const rs_makeup *mk, rs_makeup_fine_stamp **out, uint32_t *count, rs_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    const rs_makeup_applied *s = rs_makeup_log_stamps(mk);
+    uint32_t n = rs_makeup_log_count(mk), keep = 0, first = n;
+    for (uint32_t k = 0; k < n; k++) {
+        bool fine = !s[k].eraser && rs_makeup_is_fine(mk, s[k].radius);
+        if (fine && first == n) first = k;
+        if (fine || (s[k].eraser && first < n)) keep++;
+    }
+    if (keep == 0) return RS_OK;
+    rs_makeup_fine_stamp *f = rs_alloc_array(keep, sizeof *f);
+    if (!f) return rs_fail(err, RS_ERR_NOMEM, "makeup: fine layer of %u stamps: out of memory", keep);
+    uint32_t j = 0, stroke = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        stroke += k > 0 && s[k].stroke_start;
+        bool fine = !s[k].eraser && rs_makeup_is_fine(mk, s[k].radius);
+        if (!(fine || (s[k].eraser && k > first))) continue;
+        f[j++] = (rs_makeup_fine_stamp){{s[k].pos[0], s[k].pos[1], s[k].pos[2]}, s[k].radius,
+                                        {s[k].view_dir[0], s[k].view_dir[1], s[k].view_dir[2]}, s[k].amount,
+                                        s[k].cosmetic, stroke, s[k].eraser};
+    }
+    *out = f;
+    *count = j;
+    return RS_OK;
+}
+
 // --- stamping --------------------------------------------------------------------------------------
 
 typedef struct stamp_ctx {
@@ -931,7 +1035,7 @@ static void stamp_splat(stamp_ctx *x, uint32_t i)
         const float *nrm = mk->cloud->normal[i];
         if (!(nrm[0] * x->view[0] + nrm[1] * x->view[1] + nrm[2] * x->view[2] > x->facing_min)) return;
     }
-    float ig = falloff_t(d2 * x->inv_r2);
+    float ig = falloff_t(d2 * x->inv_r2, x->cos ? x->cos->hard : 0.0f);
     if (x->mask) ig *= x->mask[i] * (1.0f / 255.0f);  // outside the product's region: 0, soft at its edge
     if (!(ig > 0.0f)) return;
     x->info->touched++;
@@ -1013,6 +1117,7 @@ void rs_makeup_begin_stroke(rs_makeup *mk)
 {
     if (mk->in_stroke) rs_makeup_end_stroke(mk, NULL);
     mk->in_stroke = true;
+    mk->stroke_fine = false;
     mk->stroke_reserved = false;
     mk->stroke_first_stamp = mk->stamp_count;
     mk->slot_count = 0;
@@ -1051,11 +1156,16 @@ rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeu
     // Reserve everything first, so a failure leaves the layer untouched.
     uint32_t mirror_idx = UINT32_MAX;
     float mpos[3];
+    // A fine stamp is evaluated per pixel by the renderer: logged, no record changes (see the top).
+    bool fine = !d->eraser && rs_makeup_is_fine(mk, d->radius);
     if (d->mirror) {
         rs_makeup_mirror_point(&mk->cloud->hdr, d->pos, mpos);
         // The mirror image of a surface point lies near the other side's surface; snap to the nearest
-        // splat within one brush radius (none: the face is not symmetric there, skip the mirror).
-        if (!rs_makeup_nearest(mk, mpos, d->radius, &mirror_idx)) mirror_idx = UINT32_MAX;
+        // splat within one brush radius (none: the face is not symmetric there, skip the mirror). A fine
+        // stamp's image is projected onto the surface instead, from up to two grid cells away (a face is
+        // less symmetric than a 2 mm liner is wide).
+        float reach = fine ? RS_MAX(d->radius, 2.0f * mk->cell) : d->radius;
+        if (!rs_makeup_nearest(mk, mpos, reach, &mirror_idx)) mirror_idx = UINT32_MAX;
     }
     uint32_t need = sum_cell_counts(mk, d->pos, d->radius);
     if (mirror_idx != UINT32_MAX) need += sum_cell_counts(mk, mk->cloud->pos[mirror_idx], d->radius);
@@ -1085,12 +1195,17 @@ rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeu
                            d->eraser,
                            mk->stamp_count == mk->stroke_first_stamp,
                            masked};
-    apply_stamp(mk, &s, cos, mask, info);
+    mk->fine_version++;
+    mk->stroke_fine |= fine;
+    if (fine) mk->stamps[mk->stamp_count++] = s;
+    else apply_stamp(mk, &s, cos, mask, info);
     if (mirror_idx != UINT32_MAX) {
         memcpy(s.pos, mk->cloud->pos[mirror_idx], sizeof s.pos);
+        if (fine) surface_point(mk, mpos, 2.0f * mk->cell, s.pos);
         rs_makeup_mirror_dir(&mk->cloud->hdr, d->view_dir, s.view_dir);
         s.stroke_start = 0;
-        apply_stamp(mk, &s, cos, mask, info);
+        if (fine) mk->stamps[mk->stamp_count++] = s;
+        else apply_stamp(mk, &s, cos, mask, info);
         info->mirrored = true;
     }
     if (implicit) return rs_makeup_end_stroke(mk, err);
@@ -1167,15 +1282,16 @@ rs_result rs_makeup_end_stroke(rs_makeup *mk, rs_error *err)
         if (memcmp(&s->before, &mk->rec[s->idx], sizeof s->before) != 0 || s->touch_before != mk->touch[s->idx])
             changed++;
     }
-    if (changed == 0) {
+    if (changed == 0 && !mk->stroke_fine) {
         // Nothing happened: the stroke leaves no trace in the log or the history.
         mk->stamp_count = mk->stroke_first_stamp;
         mk->slot_count = 0;
         return RS_OK;
     }
     log_push_stroke(mk, mk->stroke_first_stamp, mk->stamp_count - mk->stroke_first_stamp, false);
-    delta *d = rs_alloc_array(changed, sizeof *d);
-    if (!d) {
+    // A stroke of fine stamps alone has no deltas: its history entry is empty, its log stroke is the change.
+    delta *d = changed ? rs_alloc_array(changed, sizeof *d) : NULL;
+    if (changed && !d) {
         mk->slot_count = 0;
         forget_all_history(mk);
         return rs_fail(err, RS_ERR_NOMEM, "makeup: undo for a stroke of %u splats: out of memory", changed);
@@ -1208,6 +1324,7 @@ void rs_makeup_cancel_stroke(rs_makeup *mk, rs_makeup_range *dirty)
         mk->slot_count = 0;
         mk->stamp_count = mk->stroke_first_stamp;
         mk->in_stroke = false;
+        mk->fine_version++;
     }
     if (dirty) *dirty = r;
 }
@@ -1235,6 +1352,7 @@ bool rs_makeup_undo(rs_makeup *mk, rs_makeup_range *dirty)
     if (mk->applied <= mk->hist_first) return false;
     apply_deltas(mk, &mk->hist[mk->applied - 1 - mk->hist_first], false, dirty);
     mk->applied--;
+    mk->fine_version++;
     return true;
 }
 
@@ -1245,6 +1363,7 @@ bool rs_makeup_redo(rs_makeup *mk, rs_makeup_range *dirty)
     if (mk->applied >= mk->stroke_count) return false;
     apply_deltas(mk, &mk->hist[mk->applied - mk->hist_first], true, dirty);
     mk->applied++;
+    mk->fine_version++;
     return true;
 }
 
@@ -1256,9 +1375,9 @@ rs_result rs_makeup_clear(rs_makeup *mk, rs_makeup_range *dirty, rs_error *err)
     uint32_t changed = 0;
     for (uint32_t i = 0; i < mk->n; i++)
         if (mk->touch[i] || memcmp(&mk->rec[i], &zero, sizeof zero) != 0) changed++;
-    if (changed == 0) return RS_OK;
-    delta *d = rs_alloc_array(changed, sizeof *d);
-    if (!d || !rs_array_grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes)) {
+    if (changed == 0 && rs_makeup_log_count(mk) == 0) return RS_OK;
+    delta *d = changed ? rs_alloc_array(changed, sizeof *d) : NULL;
+    if ((changed && !d) || !rs_array_grow((void **)&mk->strokes, &mk->stroke_cap, mk->stroke_count + 1, sizeof *mk->strokes)) {
         free(d);
         return rs_fail(err, RS_ERR_NOMEM, "makeup: clear: out of memory");
     }
@@ -1274,6 +1393,7 @@ rs_result rs_makeup_clear(rs_makeup *mk, rs_makeup_range *dirty, rs_error *err)
     }
     if (dirty) *dirty = r;
     log_push_stroke(mk, mk->stamp_count, 0, true);
+    mk->fine_version++;
     return push_history(mk, d, changed, err);
 }
 
@@ -1284,6 +1404,7 @@ void rs_makeup_reset(rs_makeup *mk, rs_makeup_range *dirty)
     memset(mk->touch, 0, mk->n);
     free_history(mk, 0);
     mk->hist_first = mk->stroke_count = mk->applied = mk->stamp_count = mk->cosmetic_count = 0;
+    mk->fine_version++;
     mark_all(mk);
     if (dirty) *dirty = (rs_makeup_range){0, mk->n};
 }

@@ -67,6 +67,7 @@ typedef enum rs_makeup_pressure {
 #define RS_MAKEUP_SIGMA_REL 0.5f    // I_G Gaussian sigma = 0.5 * brush radius (shifted to reach 0 at the rim)
 #define RS_MAKEUP_MASK_EDGE_MM 1.5f // region masks fade in over this distance inside the region's border
 #define RS_MAKEUP_LIP_SMOOTH_MM 3.0f // the lips mask: lip colour averaged over this radius (makeup.c)
+#define RS_MAKEUP_FINE_RADIUS_MM 4.0f // brushes narrower than this are the fine layer: evaluated per pixel
 
 typedef struct rs_makeup_desc {
     uint32_t undo_levels;  // strokes kept for undo/redo; 0 = 64
@@ -105,6 +106,16 @@ typedef struct rs_makeup_applied {
     uint8_t stroke_start;   // 1 on the first stamp of each stroke
     uint8_t region_mask;    // 1: kept to its cosmetic's region (rs_makeup_stamp_desc.region_mask)
 } rs_makeup_applied;
+
+// One stamp of the fine layer (a brush narrower than RS_MAKEUP_FINE_RADIUS_MM, or an eraser after one): the
+// renderer evaluates these per pixel at the picture's resolution instead of per splat (makeup.c, top).
+typedef struct rs_makeup_fine_stamp {
+    float pos[3], radius;       // model units
+    float view_dir[3], amount;  // as rs_makeup_applied
+    uint32_t cosmetic;          // index into rs_makeup_log_cosmetic; unused for the eraser
+    uint32_t stroke;            // ordinal of its stroke: a stroke's stamps take the max, strokes stack
+    uint32_t eraser;            // 1: lowers the fine layer's intensities
+} rs_makeup_fine_stamp;
 
 typedef struct rs_makeup rs_makeup;
 
@@ -165,6 +176,16 @@ const rs_cosmetic *rs_makeup_log_cosmetic(const rs_makeup *mk, uint32_t i);
 // then ignored) or for RS_COSMETIC_REGION_ANY. Fails only on out-of-memory.
 rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err);
 
+// Whether a stamp of this radius (model units) belongs to the fine layer (erasers never alone: see
+// rs_makeup_fine_stamps).
+bool rs_makeup_is_fine(const rs_makeup *mk, float radius);
+// Counts every change of the stamp log (stamp, undo, redo, clear, reset, cancel): the renderer re-reads
+// the fine layer when it moves.
+uint32_t rs_makeup_fine_version(const rs_makeup *mk);
+// The fine layer as applied now, oldest first: the fine stamps of the log and the erasers that follow the
+// first of them. *out is malloc'd (NULL when *count is 0); the caller frees it.
+rs_result rs_makeup_fine_stamps(const rs_makeup *mk, rs_makeup_fine_stamp **out, uint32_t *count, rs_error *err);
+
 // Splat nearest to pos within max_dist (model units), through the grid; false when none.
 bool rs_makeup_nearest(const rs_makeup *mk, const float pos[3], float max_dist, uint32_t *idx);
 
@@ -179,6 +200,11 @@ float rs_makeup_pressure_scale(rs_makeup_pressure map, float pressure);
 // I_G: Gaussian falloff (sigma = RS_MAKEUP_SIGMA_REL * radius), shifted and rescaled so it is 1 at the
 // centre and exactly 0 at and beyond the radius.
 float rs_makeup_falloff(float dist, float radius);
+// The tip's hardness 0..1 by product kind (pencils and liquid liners: a flat top over that fraction of
+// the radius, then a smooth fall to 0 at the rim; 0 = the Gaussian I_G of rs_makeup_falloff).
+float rs_makeup_tip_hardness(const rs_cosmetic *c);
+// I_G of a tip of that hardness (rs_makeup_falloff when hardness is 0).
+float rs_makeup_tip_falloff(float dist, float radius, float hardness);
 // I_F from the touch count.
 float rs_makeup_touch_weight(uint32_t touches);
 // Eq. (3) with the brush footprint over every term: I = I_G * (0.3 + 0.3 I_M + 0.3 I_F); equals the

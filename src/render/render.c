@@ -1,5 +1,11 @@
 // render.c — the renderer object (GPU buffers, programs, targets), the camera, and the frame that runs the
 // paper's five stages in order (Fig. 2): shadow map, visibility, attributes, diffusion, composite.
+// Pass order and what each reads: (1) shadow map (splats from the light); (2) visibility depth; (3)
+// attributes: per-splat albedo with the makeup's splat layer composed in (makeup.glsl), normal, m, rho_s,
+// ao, coat, flakes, depth-tested against (2); (4) diffusion of per-splat irradiance into D (independent of
+// albedo and finish); (5) composite: normalises (3), composes the makeup's fine layer per pixel at the
+// surface point from (2) (render_fine.c: stamps + grid in textures never attached to a framebuffer), then
+// F = A (D + S). A stamp's frame re-runs (3) and (5) only, inside its rectangle (incremental_frame).
 #include "render/render_internal.h"
 
 #include "gl/shader.h"
@@ -498,6 +504,7 @@ void rs_render_destroy(rs_renderer *r)
     rs_render_shadow_release(r);
     rs_render_pick_release(r);
     rs_render_env_release(r);
+    rs_render_fine_release(r);
     for (int k = 0; k < RS_PROG_COUNT; k++)
         for (int q = 0; q < 2; q++)
             if (r->prog[k][q]) glDeleteProgram(r->prog[k][q]);
@@ -642,6 +649,25 @@ static void mark_dirty(rs_renderer *r, uint32_t first, uint32_t count)
         d[0] = fminf(d[0], x - rad), d[1] = fminf(d[1], y - rad);
         d[2] = fmaxf(d[2], x + rad), d[3] = fmaxf(d[3], y + rad);
     }
+}
+
+void rs_render_mark_dirty_sphere(rs_renderer *r, const float pos[3], float radius)
+{
+    const rs_camera *cam = &r->inc_cam;
+    vec4 p = {pos[0], pos[1], pos[2], 1.0f}, v, c;
+    glm_mat4_mulv((vec4 *)cam->view, p, v);
+    float *d = r->dirty;
+    if (v[2] > -radius) {  // reaches the camera plane: the whole target
+        d[0] = d[1] = -INFINITY, d[2] = d[3] = INFINITY;
+        return;
+    }
+    glm_mat4_mulv((vec4 *)cam->proj, v, c);
+    float focal = cam->proj[1][1] * 0.5f * (float)cam->height;
+    float x = (c[0] / c[3] * 0.5f + 0.5f) * (float)cam->width, y = (c[1] / c[3] * 0.5f + 0.5f) * (float)cam->height;
+    // The sphere's projection fits within radius / (distance - radius); 2 pixels for the composite's 3x3 reads.
+    float rad = radius * focal / (-v[2] - radius) + 2.0f;
+    d[0] = fminf(d[0], x - rad), d[1] = fminf(d[1], y - rad);
+    d[2] = fmaxf(d[2], x + rad), d[3] = fmaxf(d[3], y + rad);
 }
 
 static void clear_dirty(rs_renderer *r)

@@ -178,6 +178,12 @@ rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count
 // into). Call once after creating the makeup layer; until then the range is 0..1.
 void rs_render_set_makeup_uniforms(rs_renderer *r, const rs_makeup_uniforms *u);
 
+// The fine layer (rs_makeup_fine_stamps; cosmetics from mk's log), evaluated per pixel in the composite.
+// Stamps that differ from the last call's (usually the new tail: one stamp) mark their screen rectangle
+// dirty, so a stamp stays incremental; a changed product list makes the next frame a full one.
+rs_result rs_render_update_fine(rs_renderer *r, const rs_makeup_fine_stamp *stamps, uint32_t count,
+                                const rs_makeup *mk, rs_error *err);
+
 rs_render_stats rs_render_get_stats(const rs_renderer *r);
 
 // Uploads a lighting environment (formats/env.h; not kept: the renderer copies what it needs) that views

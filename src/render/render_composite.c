@@ -3,7 +3,8 @@
 // F = A (D + S) (RS_COMPOSITE_PAPER, the default under the paper's lights: the paper's composite, which
 // tints the highlight by the skin colour) or F = A D + S (RS_COMPOSITE_PHYSICAL, the default under an
 // environment: a dielectric's white highlight), plus the makeup's clear coat and flakes; then exposure
-// and sRGB into the RGBA8 output. The debug views are branches of the same pass.
+// and sRGB into the RGBA8 output. The makeup's fine layer (narrow brushes) is composed per pixel here, over
+// the splat layer's A, m, rho_s, coat and flakes (render_fine.c). The debug views are branches of the same pass.
 #include "render/render_internal.h"
 
 #include <math.h>
@@ -61,9 +62,10 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
     for (int i = 0; i < 3; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
     rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
+    rs_render_fine_uniforms(r, f, prog);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
-    for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_SPEC_LUT; i++) rs_render_bind_texture(i, 0);
+    for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_FINE_INDEX; i++) rs_render_bind_texture(i, 0);
     return RS_OK;
 }

@@ -37,7 +37,23 @@ enum {
     RS_UNIT_LEVEL,       // one diffusion level's accumulation (u_level)
     RS_UNIT_ENV,         // the environment's prefiltered radiance (u_env_map)
     RS_UNIT_SPEC_LUT,    // the specular lobe's directional albedo (u_spec_lut)
+    RS_UNIT_FINE,        // the fine layer's stamps and products (u_fine_data, RGBA32F)
+    RS_UNIT_FINE_INDEX,  // the fine layer's grid: cells (start, count) then stamp lists (u_fine_index, R32UI)
 };
+
+// The fine layer as uploaded (render_fine.c): per-pixel stamps over a model-space grid.
+typedef struct rs_render_fine {
+    GLuint data_tex, index_tex;
+    int data_rows, index_rows;   // texture heights allocated (RS_FINE_TEX_WIDTH wide)
+    uint32_t count;              // stamps; 0 = no fine layer
+    uint32_t products;           // first product texel
+    float origin[3], inv_cell;
+    int dim[3];
+    rs_makeup_fine_stamp *last;  // the last upload's stamps (the dirty rectangle is their difference)
+    uint32_t last_count;
+    float *last_products;        // 12 floats per product
+    uint32_t last_product_count;
+} rs_render_fine;
 
 // The environment as uploaded (render_env.c): radiance and SH scaled by the exposure normalisation.
 typedef struct rs_render_env {
@@ -176,6 +192,7 @@ struct rs_renderer {
     bool pick_valid;
 
     rs_makeup_uniforms makeup_uni;  // makeup.glsl's colour range
+    rs_render_fine fine;            // render_fine.c
 
     rs_render_env env;          // render_env.c
     GLuint env_tex, lut_tex;
@@ -232,6 +249,11 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
 void rs_render_env_release(rs_renderer *r);
 void rs_render_shadow_release(rs_renderer *r);
 void rs_render_level_release(rs_renderer *r);
+// render_fine.c: the fine layer's uniforms and textures for the composite; its GL objects.
+void rs_render_fine_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
+void rs_render_fine_release(rs_renderer *r);
+// render.c: grows the incremental frame's dirty rectangle by a model-space sphere's screen footprint.
+void rs_render_mark_dirty_sphere(rs_renderer *r, const float pos[3], float radius);
 
 static inline GLint rs_uloc(GLuint prog, const char *name) { return glGetUniformLocation(prog, name); }
 

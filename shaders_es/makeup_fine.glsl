@@ -1,0 +1,124 @@
+// makeup_fine.glsl — the makeup's fine layer, #include'd by the composite (GLSL ES 3.00; no #version here):
+// narrow-brush stamps evaluated at the surface point a pixel sees, so their edges are as sharp as the
+// picture (src/makeup/makeup.c, "Two resolutions"; src/render/render_fine.c uploads them). The same
+// arithmetic as the splat layer: eq. (3) with the footprint on every term, the stroke's max over its
+// stamps, I_F from the strokes that reached the point, eq. (2) stacked stroke by stroke in linear light.
+//
+// u_fine_data (RGBA32F, 1024 wide): per stamp k, texels 3k..3k+2 = (pos, radius), (view_dir, amount),
+// (product, stroke, eraser, 0); from u_fine_products, per product 3 texels = (linear rgb, colour weight),
+// (m, rho_s, finish weight, I_M), (coat, shimmer, coverage, tip hardness).
+// u_fine_index (R32UI, 1024 wide): per grid cell (start, count), then the cells' stamp lists in log order.
+uniform highp sampler2D u_fine_data;
+uniform highp usampler2D u_fine_index;
+uniform int u_fine_count;        // 0: no fine layer
+uniform int u_fine_products;
+uniform vec3 u_fine_origin;
+uniform float u_fine_inv_cell;
+uniform ivec3 u_fine_dim;
+uniform vec3 rs_makeup_range_lo; // the face's colour range (makeup.glsl)
+uniform vec3 rs_makeup_range_hi;
+
+#define RS_FINE_LIST_MAX 4096    // stamps looked at per pixel, at most
+
+vec4 rs_fine_texel(int i) { return texelFetch(u_fine_data, ivec2(i & 1023, i >> 10), 0); }
+uint rs_fine_entry(uint i) { return texelFetch(u_fine_index, ivec2(int(i & 1023u), int(i >> 10u)), 0).r; }
+
+// The stacked layer at a point: colour (linear), colour intensity, coverage; finish and its intensity.
+struct rs_fine_layer {
+    vec3 cp;
+    float ci, cov;
+    float m, rho_s, coat, shimmer, si;
+};
+
+// I_G (makeup.c falloff_t): the shifted Gaussian (sigma r / 2), or a flat top with a smooth rim.
+float rs_fine_falloff(float u, float hard)
+{
+    if (u >= 1.0) return 0.0;
+    if (hard > 0.0) return smoothstep(0.0, 1.0, (1.0 - u) / (1.0 - hard));
+    const float rim = 0.1353352832;  // exp(-2)
+    return (exp(-2.0 * u * u) - rim) / (1.0 - rim);
+}
+
+// One stroke's contribution (intensity a of product p, or an eraser) stacked onto the layer (makeup.c
+// compose / rs_makeup_erase).
+void rs_fine_stack(inout rs_fine_layer l, float a, int p, bool eraser, inout float touches)
+{
+    if (a <= 0.0) return;
+    if (eraser) {
+        l.ci *= 1.0 - a;
+        l.si *= 1.0 - a;
+        if (l.ci + l.si < 0.5 / 255.0) touches = 0.0;
+        return;
+    }
+    vec4 t0 = rs_fine_texel(u_fine_products + 3 * p), t1 = rs_fine_texel(u_fine_products + 3 * p + 1);
+    vec4 t2 = rs_fine_texel(u_fine_products + 3 * p + 2);
+    float i2 = a * t0.a;
+    if (i2 > 0.0) {
+        float ii = 1.0 - (1.0 - l.ci) * (1.0 - i2), k = l.ci * (1.0 - i2);
+        l.cp = (l.cp * k + t0.rgb * i2) / ii;
+        l.cov = (l.cov * k + t2.z * i2) / ii;
+        l.ci = ii;
+    }
+    float s2 = a * t1.z;
+    if (s2 > 0.0) {
+        float ss = 1.0 - (1.0 - l.si) * (1.0 - s2), k = l.si * (1.0 - s2);
+        l.m = (l.m * k + t1.x * s2) / ss;
+        l.rho_s = (l.rho_s * k + t1.y * s2) / ss;
+        l.coat = (l.coat * k + t2.x * s2) / ss;
+        l.shimmer = (l.shimmer * k + t2.y * s2) / ss;
+        l.si = ss;
+    }
+}
+
+// Composes the fine layer at model-space point pm (unit normal nm) over the splat layer's values.
+void rs_fine_apply(vec3 pm, vec3 nm, inout vec3 albedo, inout float m, inout float rho_s, inout float coat,
+                   inout float shimmer)
+{
+    if (u_fine_count == 0) return;
+    ivec3 c = ivec3(floor((pm - u_fine_origin) * u_fine_inv_cell));
+    if (any(lessThan(c, ivec3(0))) || any(greaterThanEqual(c, u_fine_dim))) return;
+    uint cell = uint((c.z * u_fine_dim.y + c.y) * u_fine_dim.x + c.x);
+    uint start = rs_fine_entry(2u * cell), n = min(rs_fine_entry(2u * cell + 1u), uint(RS_FINE_LIST_MAX));
+    rs_fine_layer l = rs_fine_layer(vec3(0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    float touches = 0.0, best = 0.0, stroke = -1.0;
+    int product = 0;
+    bool eraser = false, reached = false;
+    for (uint k = 0u; k < n; k++) {
+        int s = int(rs_fine_entry(start + k));
+        vec4 t0 = rs_fine_texel(3 * s), t1 = rs_fine_texel(3 * s + 1), t2 = rs_fine_texel(3 * s + 2);
+        if (t2.y != stroke) {  // a new stroke: the last one's max goes onto the layer
+            rs_fine_stack(l, best, product, eraser, touches);
+            stroke = t2.y, best = 0.0, reached = false;
+        }
+        float vl = length(t1.xyz);
+        if (vl > 0.0 && dot(nm, t1.xyz) <= 0.2 * vl) continue;  // RS_MAKEUP_FACING_MIN
+        product = int(t2.x), eraser = t2.z > 0.5;
+        vec4 pr = rs_fine_texel(u_fine_products + 3 * product + 2);
+        float ig = rs_fine_falloff(length(pm - t0.xyz) / t0.w, eraser ? 0.0 : pr.w);
+        if (ig <= 0.0) continue;
+        if (!reached && !eraser) touches += 1.0;
+        reached = true;
+        float a;
+        if (eraser) {
+            a = t1.w * min(1.0, 2.0 * ig);
+        } else {
+            // eq. (3) with coverage v moving it towards the footprint (makeup.c stamp_splat).
+            float im = rs_fine_texel(u_fine_products + 3 * product + 1).w, v = pr.z;
+            float i3 = ig * (0.3 + 0.3 * im + 0.3 * (1.0 - exp(-touches)));
+            a = t1.w * (i3 + v * (min(1.0, ig * (1.0 + 2.0 * v)) - i3));
+        }
+        best = max(best, a);
+    }
+    rs_fine_stack(l, best, product, eraser, touches);
+    if (l.ci > 0.0) {
+        // eq. (2); a sheer pigment is held in the face's colour range, an opaque one keeps its own.
+        vec3 held = clamp(l.cp, rs_makeup_range_lo, rs_makeup_range_hi);
+        albedo = albedo * (1.0 - l.ci) + min(mix(held, l.cp, l.cov), vec3(1.0)) * l.ci;
+    }
+    if (l.si > 0.0) {
+        m = mix(m, l.m, l.si);
+        rho_s = mix(rho_s, l.rho_s, l.si);
+        coat = mix(coat, l.coat, l.si);
+        shimmer = mix(shimmer, l.shimmer, l.si);
+    }
+}
