@@ -1,36 +1,58 @@
 #!/bin/sh
 # Runs every test program (build/tests/test_*) and script (tests/test_*.sh) and sums up their
 # "ok"/"FAIL"/"skip" lines into the closing "N passed, N failed, N skipped" line.
+# Tests run RS_TEST_JOBS at a time (default: the number of cores), the longest first so the short ones
+# fill in beside them; each one's output is printed whole, in name order, once all have run.
 # Usage: tests/run.sh [BUILD_DIR] [NAME_FILTER...]
 build=${1:-build}
 [ $# -gt 0 ] && shift
-log=$(mktemp)
-trap 'rm -f "$log"' EXIT
-status=0
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
 export RS_BUILD="$build"
 export RS_TEST_OUT="$build/test-out"
 mkdir -p "$RS_TEST_OUT"
+jobs=${RS_TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
+
+# The slow ones (minutes on 2 cores) first; then the rest in name order.
+slow="tests/test_valgrind.sh tests/test_web.sh tests/test_viewer.sh $build/tests/test_mobile tests/test_env_tool.sh
+      $build/tests/test_import $build/tests/test_render $build/tests/test_edges"
+all=""
 for t in "$build"/tests/test_* tests/test_*.sh; do
     [ -f "$t" ] || continue
     case "$t" in *.d|*.o) continue ;; esac
-    echo "# $t"
+    all="$all $t"
+done
+order=""
+for t in $slow; do case " $all " in *" $t "*) order="$order $t" ;; esac; done
+for t in $all; do case " $slow " in *" $t "*) ;; *) order="$order $t" ;; esac; done
+
+# One test: its output to LOGS/NAME.log, its exit status to LOGS/NAME.rc.
+export logs build
+export RS_FILTERS="$*"
+# shellcheck disable=SC2016,SC2086
+printf '%s\n' $order | xargs -P "$jobs" -I{} sh -c '
+    t={}; n=$(echo "$t" | tr / _)
     case "$t" in
-        *.sh) sh "$t" "$build" "$@" ;;
-        *) "$t" "$@" ;;
-    esac > "$log.one" 2>&1
-    rc=$?
-    cat "$log.one"
-    cat "$log.one" >> "$log"
-    if [ $rc -ne 0 ]; then
+        *.sh) sh "$t" "$build" $RS_FILTERS ;;
+        *) "$t" $RS_FILTERS ;;
+    esac > "$logs/$n.log" 2>&1
+    echo $? > "$logs/$n.rc"'
+
+status=0
+for t in $all; do
+    n=$(echo "$t" | tr / _)
+    echo "# $t"
+    cat "$logs/$n.log"
+    rc=$(cat "$logs/$n.rc" 2>/dev/null || echo 1)
+    if [ "$rc" -ne 0 ]; then
         status=1
         # A crash or an error exit without a FAIL line still counts as a failure.
-        grep -q '^FAIL - ' "$log.one" || { echo "FAIL - $t: exited with status $rc"; echo "FAIL - $t" >> "$log"; }
+        grep -q '^FAIL - ' "$logs/$n.log" || { echo "FAIL - $t: exited with status $rc"; echo "FAIL - $t" >> "$logs/$n.log"; }
     fi
 done
-rm -f "$log.one"
-p=$(grep -c '^ok - ' "$log")
-f=$(grep -c '^FAIL - ' "$log")
-s=$(grep -c '^skip - ' "$log")
+p=$(cat "$logs"/*.log | grep -c '^ok - ')
+f=$(cat "$logs"/*.log | grep -c '^FAIL - ')
+s=$(cat "$logs"/*.log | grep -c '^skip - ')
 [ "$f" -gt 0 ] && status=1
 echo "$p passed, $f failed, $s skipped"
 exit $status
