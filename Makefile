@@ -43,9 +43,9 @@ LIBS := $(BUILD)/librouge.a $(PKG_LIBS) -lm -pthread
 # Tests also link the app's parts (UI, viewer, CLI) through libapp.a; the converter's tests libpack.
 TEST_LIBS := $(BUILD)/libapp.a $(LIBS)
 PACK_TESTS := test_pack test_ply test_import
-# The converter's import (tools/pack/import_assimp.c, image_load.c): assimp, and stb_image's header.
+# The converter's import (tools/pack/import_assimp.c, image_load.c): assimp, libjpeg-turbo, stb_image's header.
 PACK_CFLAGS := $(shell pkg-config --cflags assimp stb 2>/dev/null)
-PACK_LIBS   := $(shell pkg-config --libs assimp 2>/dev/null)
+PACK_LIBS   := $(shell pkg-config --libs assimp libjpeg 2>/dev/null)
 
 VERSION  := 0.1.0
 SOMAJOR  := 0

@@ -10,6 +10,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#include <jpeglib.h>
 
 #define FX "tests/fixtures/import/"
 
@@ -41,7 +44,7 @@ static void test_obj_two_pages_sample_each_face_from_its_page(void)
              s->mesh->vertex_count, s->mesh->tri_count);
     RS_CHECK(strstr(s->mesh->comments, "two squares, two texture pages") != NULL, "comments '%s'", s->mesh->comments);
     rs_image *pages = NULL;
-    RS_REQUIRE(rs_import_load_pages(s, &pages, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_import_load_pages(s, &pages, NULL, 0, &err) == RS_OK, "%s", err.msg);
     RS_CHECK(!pages[0].pixels && pages[1].width == 4 && pages[2].width == 4, "page sizes");
     rs_pack_report rep;
     rs_splat_cloud *c = convert(s, pages, 4000, &rep);
@@ -77,7 +80,7 @@ static void test_glb_embedded_texture_and_metres(void)
              "embedded page");
     RS_CHECK(strstr(s->mesh->comments, "copyright: CC0 rouge test fixture") != NULL, "comments '%s'", s->mesh->comments);
     rs_image *pages = NULL;
-    RS_REQUIRE(rs_import_load_pages(s, &pages, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_import_load_pages(s, &pages, NULL, 0, &err) == RS_OK, "%s", err.msg);
     RS_CHECK(pages[0].width == 2 && pages[0].height == 2 && pages[0].pixels[1] == 200, "decoded embedded PNG");
     rs_pack_report rep;
     rs_splat_cloud *c = convert(s, pages, 1000, &rep);
@@ -152,13 +155,16 @@ static void test_bad_models_fail_with_one_line(void)
         RS_CHECK(r != RS_OK && !s && strstr(err.msg, cases[i].want) && !strchr(err.msg, '\n'), "%s: %s", cases[i].file, err.msg);
         rs_import_destroy(s);
     }
-    // A material naming a texture that is not there: the model loads, its pages do not.
+    // A material naming a texture that is not there: the model loads, its page stays empty with a warning.
     rs_error err = {0};
     rs_import_scene *s = NULL;
     RS_REQUIRE(rs_import_load(FX "bad_missing_texture.obj", &s, &err) == RS_OK, "%s", err.msg);
     rs_image *pages = NULL;
-    RS_CHECK(rs_import_load_pages(s, &pages, &err) != RS_OK && !pages && strstr(err.msg, "'no such file.jpg', which is not there"),
-             "%s", err.msg);
+    char warn[1024] = "";
+    RS_CHECK(rs_import_load_pages(s, &pages, warn, sizeof warn, &err) == RS_OK && pages && strstr(warn, "'no such file.jpg', which is not there"),
+             "%s", warn);
+    for (uint32_t i = 0; pages && i < s->page_count; i++) RS_CHECK(!pages[i].pixels, "page %u has pixels", i);
+    rs_import_free_pages(pages, s->page_count);
     rs_import_destroy(s);
 }
 
@@ -314,7 +320,7 @@ static void test_jpeg_and_png_textures_decode_with_limits(void)
         {FX "bad_truncated.jpg", "JPEG is truncated", RS_ERR_FORMAT},
         {FX "bad_huge.jpg", "16000x16000 = 256.0 Mpx, more than the 67 Mpx allowed", RS_ERR_LIMIT},
         {FX "bad_bomb.jpg", "cannot hold that much data", RS_ERR_FORMAT},
-        {FX "two_pages.obj", "not a PNG or JPEG file (starts 23 20 72 6f)", RS_ERR_FORMAT},
+        {FX "two_pages.obj", "not a PNG, JPEG, BMP or TGA file (starts 23 20 72 6f)", RS_ERR_FORMAT},
         {"tests/fixtures/bad/png_huge_dimensions.png", "larger than the 16384 allowed", RS_ERR_LIMIT},
         {"tests/fixtures/bad/png_truncated.png", "truncated", RS_ERR_FORMAT},
         {"/dev/zero", "not a regular file", RS_ERR_IO},
@@ -561,6 +567,232 @@ static void test_partial_scan_keeps_face_and_regions(void)
     scan_free(&s);
 }
 
+
+// ---- textures of every kind (issue 24, item 1), fixtures written here ----
+
+// An 8x2 image, left half red (220 30 30), right half blue (30 30 220), as `kind`: "bmp" (24-bit,
+// bottom-up rows padded to 4 bytes), "tga" (uncompressed 24-bit, bottom-up) or "tga_rle" (run-length).
+static bool write_halves(const char *path, const char *kind)
+{
+    enum { W = 8, H = 2 };
+    uint8_t buf[512];
+    size_t n = 0;
+    bool bmp = !strcmp(kind, "bmp"), rle = !strcmp(kind, "tga_rle");
+    if (bmp) {
+        uint32_t row = (W * 3 + 3) & ~3u, size = 54 + row * H;
+        uint8_t h[54] = {'B', 'M', (uint8_t)size, (uint8_t)(size >> 8), 0, 0, 0, 0, 0, 0, 54, 0, 0, 0, 40, 0, 0, 0, W, 0, 0, 0,
+                         H, 0, 0, 0, 1, 0, 24, 0};
+        memcpy(buf, h, 54);
+        n = 54;
+    } else {
+        uint8_t h[18] = {0, 0, rle ? 10 : 2, 0, 0, 0, 0, 0, 0, 0, 0, 0, W, 0, H, 0, 24, 0};
+        memcpy(buf, h, 18);
+        n = 18;
+    }
+    for (int y = 0; y < H; y++) {
+        if (rle) {
+            // Two runs per row: 4 red pixels, 4 blue (packet header 0x80 | (count - 1), then one BGR pixel).
+            const uint8_t red[4] = {0x83, 30, 30, 220}, blue[4] = {0x83, 220, 30, 30};
+            memcpy(buf + n, red, 4), memcpy(buf + n + 4, blue, 4);
+            n += 8;
+            continue;
+        }
+        for (int x = 0; x < W; x++) {
+            uint8_t b = x < W / 2 ? 30 : 220, r = x < W / 2 ? 220 : 30;
+            buf[n++] = b, buf[n++] = 30, buf[n++] = r;
+        }
+        while (bmp && n % 4 != 54 % 4) buf[n++] = 0;
+    }
+    FILE *f = fopen(path, "wb");
+    if (!f) return false;
+    bool ok = fwrite(buf, 1, n, f) == n;
+    return fclose(f) == 0 && ok;
+}
+
+// The same halves as a progressive JPEG (libjpeg's simple progression: what stb_image 2.27 refused),
+// 64x16 so the colour survives the chroma subsampling.
+static bool write_progressive_jpeg(const char *path)
+{
+    enum { W = 64, H = 16 };
+    FILE *f = fopen(path, "wb");
+    if (!f) return false;
+    struct jpeg_compress_struct j;
+    struct jpeg_error_mgr e;
+    j.err = jpeg_std_error(&e);
+    jpeg_create_compress(&j);
+    jpeg_stdio_dest(&j, f);
+    j.image_width = W, j.image_height = H, j.input_components = 3, j.in_color_space = JCS_RGB;
+    jpeg_set_defaults(&j);
+    jpeg_set_quality(&j, 95, TRUE);
+    jpeg_simple_progression(&j);
+    jpeg_start_compress(&j, TRUE);
+    uint8_t row[W * 3];
+    for (int x = 0; x < W; x++) row[3 * x] = x < W / 2 ? 220 : 30, row[3 * x + 1] = 30, row[3 * x + 2] = x < W / 2 ? 30 : 220;
+    while (j.next_scanline < H) {
+        JSAMPROW r = row;
+        jpeg_write_scanlines(&j, &r, 1);
+    }
+    jpeg_finish_compress(&j);
+    jpeg_destroy_compress(&j);
+    return fclose(f) == 0;
+}
+
+static bool write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f) return false;
+    bool ok = fputs(text, f) >= 0;
+    return fclose(f) == 0 && ok;
+}
+
+// dir/name.obj: a 6 x 1 quad whose u runs 0..6 (a texture tiled six times), with dir/name.mtl holding
+// `map_line` for its one material.
+static bool write_tiled_quad(const char *dir, const char *name, const char *map_line)
+{
+    char obj[512], mtl[512], text[1024];
+    snprintf(obj, sizeof obj, "%s/%s.obj", dir, name);
+    snprintf(mtl, sizeof mtl, "%s/%s.mtl", dir, name);
+    snprintf(text, sizeof text, "newmtl skin\nKd 1 1 1\n%s\n", map_line);
+    if (!write_text(mtl, text)) return false;
+    snprintf(text, sizeof text, "mtllib %s.mtl\nv 0 0 0\nv 6 0 0\nv 6 1 0\nv 0 1 0\nvt 0 0\nvt 6 0\nvt 6 1\nvt 0 1\n"
+                                "usemtl skin\nf 1/1 2/2 3/3\nf 1/1 3/3 4/4\n", name);
+    return write_text(obj, text);
+}
+
+// Converts dir/name.obj with its pages; the fraction of splats that came out red (NaN when it did not
+// convert), and the warnings in warn[cap].
+static double red_fraction(const char *dir, const char *name, char *warn, size_t cap, uint32_t *textured)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s.obj", dir, name);
+    rs_error err = {0};
+    rs_import_scene *s = NULL;
+    warn[0] = 0;
+    *textured = 0;
+    if (rs_import_load(path, &s, &err) != RS_OK) {
+        RS_CHECK(false, "%s: %s", path, err.msg);
+        return NAN;
+    }
+    snprintf(warn, cap, "%s", s->mesh->warnings);
+    size_t len = strlen(warn);
+    rs_image *pages = NULL;
+    if (rs_import_load_pages(s, &pages, warn + len, cap - len, &err) != RS_OK) {
+        RS_CHECK(false, "%s: %s", path, err.msg);
+        rs_import_destroy(s);
+        return NAN;
+    }
+    uint8_t(*wrap)[2] = calloc(s->page_count + 1, sizeof *wrap);
+    for (uint32_t i = 0; i < s->page_count; i++) {
+        *textured += pages[i].pixels != NULL;
+        memcpy(wrap[i], s->pages[i].wrap, 2);
+    }
+    rs_pack_desc d = {.points = 3000, .pages = pages, .page_count = s->page_count, .page_wrap = (const uint8_t(*)[2])wrap,
+                      .mm_per_unit = 1, .no_ao = true};
+    rs_splat_cloud *c = NULL;
+    rs_pack_report rep;
+    double red = NAN;
+    if (rs_pack_convert(s->mesh, &d, &c, &rep, &err) == RS_OK) {
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < c->hdr.count; i++) {
+            rs_splat sp;
+            rs_splat_get(c, i, &sp);
+            n += sp.rgb[0] > 150 && sp.rgb[2] < 100;
+        }
+        red = (double)n / c->hdr.count;
+        RS_CHECK(rep.colour_default == (*textured == 0), "%s: colour_default %d with %u textured pages", name,
+                 rep.colour_default, *textured);
+    } else {
+        RS_CHECK(false, "%s: %s", name, err.msg);
+    }
+    rs_splat_destroy(c);
+    free(wrap);
+    rs_import_free_pages(pages, s->page_count);
+    rs_import_destroy(s);
+    return red;
+}
+
+static void test_bmp_tga_and_progressive_jpeg_decode(void)
+{
+    char dir[512], path[600];
+    snprintf(dir, sizeof dir, "%s/textures_of_every_kind", rs_test_out_dir());
+    mkdir(dir, 0755);
+    static const char *const kinds[] = {"bmp", "tga", "tga_rle", "jpg"};
+    for (size_t k = 0; k < RS_COUNT_OF(kinds); k++) {
+        snprintf(path, sizeof path, "%s/halves.%s", dir, kinds[k]);
+        bool jpg = !strcmp(kinds[k], "jpg");
+        RS_REQUIRE(jpg ? write_progressive_jpeg(path) : write_halves(path, kinds[k]), "cannot write %s", path);
+        rs_error err = {0};
+        rs_image img = {0};
+        rs_result r = rs_image_load_any(path, &img, &err);
+        RS_CHECK(r == RS_OK, "%s: %s", kinds[k], err.msg);
+        if (r != RS_OK) continue;
+        int w = jpg ? 64 : 8, tol = jpg ? 12 : 0;
+        const uint8_t *left = img.pixels + 3 * 1, *right = img.pixels + 3 * (w - 2);
+        RS_CHECK(img.width == w && img.height == (jpg ? 16 : 2) && img.channels == 3, "%s: %dx%dx%d", kinds[k], img.width,
+                 img.height, img.channels);
+        RS_CHECK(abs(left[0] - 220) <= tol && abs(left[2] - 30) <= tol && abs(right[0] - 30) <= tol && abs(right[2] - 220) <= tol,
+                 "%s: left %u %u %u, right %u %u %u", kinds[k], left[0], left[1], left[2], right[0], right[1], right[2]);
+        rs_image_free(&img);
+    }
+    // Embedded images take the same decoder: a TGA's bytes from memory (no signature to go by).
+    void *data;
+    size_t len;
+    rs_error err = {0};
+    snprintf(path, sizeof path, "%s/halves.tga_rle", dir);
+    RS_REQUIRE(rs_file_read_all(path, 1 << 20, &data, &len, &err) == RS_OK, "%s", err.msg);
+    rs_image img = {0};
+    RS_CHECK(rs_image_decode_any(data, len, "embedded", &img, &err) == RS_OK && img.width == 8, "%s", err.msg);
+    rs_image_free(&img);
+    free(data);
+}
+
+static void test_textures_wrap_resolve_and_never_stop_a_conversion(void)
+{
+    char dir[512], path[600];
+    snprintf(dir, sizeof dir, "%s/textures_of_every_kind", rs_test_out_dir());
+    mkdir(dir, 0755);
+    snprintf(path, sizeof path, "%s/textures", dir);
+    mkdir(path, 0755);
+    snprintf(path, sizeof path, "%s/textures/skin.tga", dir);
+    RS_REQUIRE(write_halves(path, "tga"), "cannot write %s", path);
+    snprintf(path, sizeof path, "%s/skin.bmp", dir);
+    RS_REQUIRE(write_halves(path, "bmp"), "cannot write %s", path);
+    snprintf(path, sizeof path, "%s/skin.jpg", dir);
+    RS_REQUIRE(write_progressive_jpeg(path), "cannot write %s", path);
+    static const struct {
+        const char *name, *map, *warn;  // warn: a warning it must give ("" none)
+        double red_lo, red_hi;          // the red fraction: ~1/2 tiled, ~1/12 clamped, -1 untextured
+    } cases[] = {
+        // u 0..6 repeats the texture (it was clamped: the red half appeared once, at the left end).
+        {"wrap_bmp", "map_Kd skin.bmp", "", 0.42, 0.58},
+        {"wrap_progressive_jpeg", "map_Kd skin.jpg", "", 0.42, 0.58},
+        // The material's own mode: MTL's -clamp on is AI_MATKEY_MAPPINGMODE_U/V = clamp.
+        {"clamp_mode", "map_Kd -clamp on skin.bmp", "", 0.04, 0.13},
+        // Windows paths: a leading backslash (a DAE's) and a drive letter name files below the folder.
+        {"backslash_path", "map_Kd \\textures\\skin.tga", "", 0.42, 0.58},
+        {"drive_letter_path", "map_Kd C:\\work\\scans\\skin.bmp", "", 0.42, 0.58},
+        // Missing, placeholder and unreadable textures warn, and the model converts in the default grey.
+        {"missing", "map_Kd gone.png", "'gone.png', which is not there", -1, -1},
+        {"placeholder", "map_Kd $texture_dummy.bmp", "placeholder texture '$texture_dummy.bmp' (the file names no texture assimp found); coloured from the default grey instead", -1, -1},
+        {"unreadable", "map_Kd halves_wrong.png", "not a PNG, JPEG, BMP or TGA file", -1, -1},
+    };
+    snprintf(path, sizeof path, "%s/halves_wrong.png", dir);
+    RS_REQUIRE(write_text(path, "this is not an image at all, only words"), "cannot write %s", path);
+    for (size_t i = 0; i < RS_COUNT_OF(cases); i++) {
+        RS_REQUIRE(write_tiled_quad(dir, cases[i].name, cases[i].map), "cannot write %s", cases[i].name);
+        char warn[2048];
+        uint32_t textured = 0;
+        double red = red_fraction(dir, cases[i].name, warn, sizeof warn, &textured);
+        if (cases[i].red_lo < 0) {
+            RS_CHECK(red == 0 && textured == 0, "%s: red %.3f, %u pages textured", cases[i].name, red, textured);
+        } else {
+            RS_CHECK(red >= cases[i].red_lo && red <= cases[i].red_hi && textured == 1, "%s: red %.3f (want %.2f..%.2f), %u textured",
+                     cases[i].name, red, cases[i].red_lo, cases[i].red_hi, textured);
+        }
+        RS_CHECK(cases[i].warn[0] ? strstr(warn, cases[i].warn) != NULL : !warn[0], "%s: warnings '%s'", cases[i].name, warn);
+    }
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -572,6 +804,8 @@ int main(int argc, char **argv)
     RS_RUN(test_memory_import_matches_file);
     RS_RUN(test_guard_refuses_hostile_structure);
     RS_RUN(test_jpeg_and_png_textures_decode_with_limits);
+    RS_RUN(test_bmp_tga_and_progressive_jpeg_decode);
+    RS_RUN(test_textures_wrap_resolve_and_never_stop_a_conversion);
     RS_RUN(test_lee_perry_smith_glb_matches_ply);
     RS_RUN(test_scale_rule_reads_units_from_the_head);
     RS_RUN(test_frame_survives_random_rotations);

@@ -73,6 +73,17 @@ expect pack_converts_textured_mesh 0 "" "$pack" "$fx/mesh_st.ply" -o "$tmp/g.rsf
     --specular-map tests/fixtures/image/c_4x4.png --region-map tests/fixtures/image/a_8x8.png --preview "$tmp/g.png"
 if [ -s "$tmp/g.png" ]; then echo "ok - pack_writes_preview"; else echo "FAIL - pack_writes_preview: no PNG"; fi
 has pack_summary_measures_specular_map "$tmp/out" "specular map"
+# A PLY whose surface is triangle strips is refused by name, not read as its vertices alone (issue 24).
+printf 'ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement tristrips 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n4 0 1 2 3\n' >"$tmp/strips.ply"
+expect pack_tristrips_refused 1 "element tristrips: triangle strips are not read" "$pack" "$tmp/strips.ply" -o "$tmp/ts.rsf"
+no_file pack_tristrips_leaves_no_output "$tmp/ts.rsf"
+# A texture that is not there (issue 24): a warning, the conversion goes on, and the summary says the
+# colour is the default grey (not "from the input") and names the input's format (not "PLY").
+expect pack_missing_texture_warns_and_converts 0 "warning: .*'no such file.jpg', which is not there.*default grey" \
+    "$pack" tests/fixtures/import/bad_missing_texture.obj -o "$tmp/mt.rsf" --points 2000
+has pack_summary_says_default_grey "$tmp/out" "colour        none in the input: light warm grey"
+has pack_summary_names_the_format "$tmp/out" "input Wavefront OBJ: [0-9]* bytes"
+if [ -s "$tmp/mt.rsf" ]; then echo "ok - pack_missing_texture_writes_output"; else echo "FAIL - pack_missing_texture_writes_output"; fi
 expect pack_quiet_prints_nothing 0 "" "$pack" "$fx/points_ascii.ply" -o "$tmp/h.rsf" -q
 if [ -s "$tmp/out" ]; then echo "FAIL - pack_quiet_stdout_empty: $(head -c 200 "$tmp/out")"; else echo "ok - pack_quiet_stdout_empty"; fi
 a=$(wc -c <"$tmp/f.rsf"); b=$(wc -c <"$tmp/h.rsf")

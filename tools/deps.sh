@@ -2,7 +2,7 @@
 # make deps: checks what rouge needs and installs only what is missing, from Debian's packages.
 # Build: pkg-config modules egl glesv2 glfw3 libpng cglm. Run/test: Mesa's EGL + GLES drivers (libegl-mesa0,
 # libgl1-mesa-dri: software rendering with llvmpipe when there is no GPU), Xvfb + xauth + xdotool for the
-# window test. Scan import (tools/pack): assimp, stb_image (JPEG/PNG textures). Compact .rsf v2: zstd,
+# window test. Scan import (tools/pack): assimp, libjpeg-turbo (JPEG textures), stb_image (BMP/TGA textures). Compact .rsf v2: zstd,
 # meshoptimizer (no .pc file in Debian: found by its header). Environment preprocessing (tools/env, tools-time
 # only): OpenEXR 3 C API, and blender-data's CC0 HDRIs as the sources of assets/env/. Uses sudo when not root.
 set -u
@@ -13,7 +13,7 @@ command -v cc >/dev/null 2>&1 || need gcc
 command -v make >/dev/null 2>&1 || need make
 command -v pkg-config >/dev/null 2>&1 || need pkg-config
 for pair in egl:libegl-dev glesv2:libgles-dev glfw3:libglfw3-dev libpng:libpng-dev cglm:libcglm-dev \
-            assimp:libassimp-dev stb:libstb-dev libzstd:libzstd-dev OpenEXR:libopenexr-dev; do
+            assimp:libassimp-dev libjpeg:libjpeg62-turbo-dev stb:libstb-dev libzstd:libzstd-dev OpenEXR:libopenexr-dev; do
     mod=${pair%%:*}
     pkg=${pair#*:}
     pkg-config --exists "$mod" 2>/dev/null || need "$pkg"

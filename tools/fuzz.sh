@@ -51,7 +51,7 @@ make --no-print-directory -s BUILD="$dir/lib" CC="$cc" OPT=-O1 \
     EXTRA_CFLAGS="-Wno-unknown-warning-option -fsanitize=fuzzer-no-link $san" \
     "$dir/lib/librouge.a" "$dir/lib/libpack.a" >"$dir/build.log" 2>&1 ||
     { tail -n 20 "$dir/build.log" >&2; die "library build failed (log: $dir/build.log)"; }
-pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm libzstd assimp 2>/dev/null)
+pkgs=$(pkg-config --cflags --libs egl glesv2 glfw3 libpng cglm libzstd assimp libjpeg 2>/dev/null)
 for t in $targets; do
     src="tools/fuzz/fuzz_$t.c"
     [ -f "$src" ] || die "no harness $src (FUZZ_TARGETS: ply rsf strokes look convert env envmap import image)"

@@ -31,11 +31,11 @@ static const char usage[] =
     "Input: PLY (ASCII or binary, rouge's own reader), or through assimp OBJ (+ MTL), glTF / GLB, FBX,\n"
     "STL, DAE, 3DS, OFF and the other formats assimp reads. A point cloud is used as it is, a mesh is\n"
     "sampled area-uniformly. Colour: --texture, else each material's base-colour texture (MTL map_Kd,\n"
-    "glTF baseColorTexture, embedded GLB images; PNG or JPEG; several materials sample each face from\n"
+    "glTF baseColorTexture, embedded GLB images; PNG, JPEG, BMP or TGA; several materials sample each face from\n"
     "its own page), else the vertex colours.\n"
     "  --points N          mesh: number of splats to sample (default 600000); cloud: decimate to N\n"
     "                      (a Poisson-disk-like subset); default keeps every point\n"
-    "  --texture IMAGE     sRGB colour map (PNG or JPEG) for every face, sampled bilinearly at (s, 1 - t)\n"
+    "  --texture IMAGE     sRGB colour map (PNG, JPEG, BMP, TGA) for every face, sampled bilinearly at (s, 1 - t)\n"
     "                      with the coordinates as the file stores them: t = 0 is the bottom row\n"
     "  --normal-map PNG    tangent-space normal map (OpenGL convention, +G along +t); mesh only\n"
     "  --specular-map PNG  specular-intensity map: measured per region and printed in the summary only;\n"
@@ -349,11 +349,16 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
                o->pages_textured, o->pages_textured > 1 ? "s" : "");
     else
         printf("  colour        %s\n", rep->colour_default ? "none in the input: light warm grey (sRGB 200 178 160)"
-                                                            : (o->maps[0] ? "from the texture" : "from the input"));
+                                                            : o->maps[0]           ? "from the texture"
+                                                            : rep->sampled_mesh    ? "from the input's vertex colours"
+                                                                                   : "from the input");
+    if (!rep->colour_default && rep->colour_default_points)
+        printf("                %.1f%% of the splats light warm grey (no readable texture or vertex colour there)\n",
+               100.0 * rep->colour_default_points / (rep->splats ? rep->splats : 1));
     if (o->texture_hint[0])
         printf("  note          the PLY names the texture '%s'; pass --texture to colour from it\n", o->texture_hint);
-    printf("  size          %lld bytes = %.2f bytes/splat (input PLY: %lld bytes = %.2f bytes/%s)\n", out_size,
-           (double)out_size / c->hdr.count, in_size, (double)in_size / (rep->input_vertices ? rep->input_vertices : 1),
+    printf("  size          %lld bytes = %.2f bytes/splat (input %s: %lld bytes = %.2f bytes/%s)\n", out_size,
+           (double)out_size / c->hdr.count, o->format, in_size, (double)in_size / (rep->input_vertices ? rep->input_vertices : 1),
            rep->sampled_mesh ? "vertex" : "point");
     printf("  LOD           %u prefix%s:", c->hdr.lod_count, c->hdr.lod_count == 1 ? "" : "es");
     for (uint32_t i = 0; i < c->hdr.lod_count; i++) printf(" %u", c->hdr.lods[i]);
@@ -361,6 +366,8 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
     if (f->found) {
         printf("  face          nose tip (%.3f %.3f %.3f), mouth (%.3f %.3f %.3f), height %.3f units\n", f->nose_tip[0],
                f->nose_tip[1], f->nose_tip[2], f->mouth[0], f->mouth[1], f->mouth[2], f->face_height);
+    } else if (rep->face_rejected) {
+        printf("  face          rejected (its landmarks were not finite): every splat is `other`, framed by the bounds\n");
     } else {
         printf("  face          not found: every splat is `other` (see --help for the assumptions)\n");
     }
@@ -429,16 +436,28 @@ static int convert(options *o)
         *slot[k] = &img[k];
     }
     // The materials' own colour textures, unless --texture replaces them.
+    // A texture that cannot be used is a warning: the conversion goes on with vertex colours or grey.
     rs_image *pages = NULL;
-    if (!o->maps[0] && rs_import_load_pages(scene, &pages, &err) != RS_OK) {
+    char tex_warnings[2048] = "";
+    if (!o->maps[0] && rs_import_load_pages(scene, &pages, tex_warnings, sizeof tex_warnings, &err) != RS_OK) {
         for (int k = 0; k < 4; k++) rs_image_free(&img[k]);
         rs_import_destroy(scene);
         return fail(1, "%s", err.msg);
     }
+    if (tex_warnings[0]) {
+        char w[sizeof tex_warnings * 4];
+        rs_text_sanitize(w, sizeof w, tex_warnings, strlen(tex_warnings));
+        fprintf(stderr, "rouge-pack: warning: %s: %s\n", o->input, w);
+    }
     uint32_t page_count = pages ? scene->page_count : 0;
-    for (uint32_t i = 0; i < page_count; i++) o->pages_textured += pages[i].pixels != NULL;
+    uint8_t(*wrap)[2] = page_count ? calloc(page_count, sizeof *wrap) : NULL;
+    for (uint32_t i = 0; i < page_count; i++) {
+        o->pages_textured += pages[i].pixels != NULL;
+        if (wrap) memcpy(wrap[i], scene->pages[i].wrap, sizeof wrap[i]);
+    }
     o->desc.pages = pages;
     o->desc.page_count = page_count;
+    o->desc.page_wrap = (const uint8_t(*)[2])wrap;
     double load_s = rs_time_now() - t0;
 
     char notes[512];
@@ -469,7 +488,9 @@ static int convert(options *o)
     if (bar.on) fputs("\r\033[K", stderr);
     for (int k = 0; k < 4; k++) rs_image_free(&img[k]);
     rs_import_free_pages(pages, page_count);
+    free(wrap);
     o->desc.pages = NULL;
+    o->desc.page_wrap = NULL;
     rs_import_destroy(scene);
     if (r != RS_OK) return fail(1, "%s: %s", o->input, err.msg);
 
@@ -498,8 +519,10 @@ static int convert(options *o)
                 cloud->hdr.mm_per_unit, rep.scale_why);
     // Said even with -q (on stderr, once the file is written): the result is not what the face defaults give.
     if (!rep.face.found)
-        fprintf(stderr, "rouge-pack: note: %s: no face found (in any orientation, nor +y up, +z forward); converted %s as a plain "
-                        "model, framed by its bounding box\n", o->input, whole ? "every component" : "it");
+        fprintf(stderr, "rouge-pack: note: %s: %s; converted %s as a plain model, framed by its bounding box\n", o->input,
+                rep.face_rejected ? "a face was found but its frame is not finite, so it is not used"
+                                  : "no face found (in any orientation, nor +y up, +z forward)",
+                whole ? "every component" : "it");
     rs_splat_destroy(cloud);
     return 0;
 }

@@ -39,7 +39,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     rs_image *pages = NULL;
-    if (rs_import_load_pages(s, &pages, &err) != RS_OK && err.msg[0] == 0) __builtin_trap();
+    char warnings[1024] = "";
+    if (rs_import_load_pages(s, &pages, warnings, sizeof warnings, &err) != RS_OK && err.msg[0] == 0) __builtin_trap();
     // Few samples, small models, no occlusion pass: the converter has its own harness (fuzz_convert).
     if (s->mesh->vertex_count <= 5000) {
         rs_pack_desc d = {.points = 500, .no_ao = true, .pages = pages, .page_count = pages ? s->page_count : 0,

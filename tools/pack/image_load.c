@@ -1,16 +1,21 @@
-// image_load.c — texture images for rouge-pack: PNG or JPEG by content (see import.h).
+// image_load.c — texture images for rouge-pack: PNG, JPEG, BMP or TGA by content (see import.h).
 //
 // One decoder per format: PNG goes through src/core/image.c (libpng, already used to write PNGs, with its
-// own bomb check), JPEG through stb_image (Debian's libstb-dev: one public-domain header, no state, and
-// it decodes baseline and progressive JPEG from memory). stb is compiled here with only its JPEG decoder,
-// so no second PNG decoder is linked in.
+// own bomb check); JPEG through libjpeg-turbo, because Debian 12's stb_image (2.27) refuses valid
+// progressive JPEGs ("unknown marker") that scans and phone photos come in; BMP and TGA through stb_image
+// (Debian's libstb-dev: one public-domain header, no state), compiled here with only those two decoders.
 #include "pack/import.h"
 
+#include <setjmp.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define STBI_ONLY_JPEG
+#include <jpeglib.h>
+#include <jerror.h>
+
+#define STBI_ONLY_BMP
+#define STBI_ONLY_TGA
 #define STBI_NO_STDIO
 #define STBI_NO_LINEAR
 #define STBI_NO_HDR
@@ -30,18 +35,18 @@
 
 // A JPEG codes every 8x8 block of every component with at least one bit (a 1-bit DC difference code;
 // progressive end-of-band runs skip only AC coefficients), so n bytes hold at most 8 n blocks: a header
-// claiming more is a decompression bomb, refused before stb allocates the image.
+// claiming more is a decompression bomb, refused before the decoder allocates the image.
 #define JPEG_MIN_BITS_PER_BLOCK 1u
 
 // Walks the JPEG's marker segments (and over the entropy-coded data after each scan header, where
-// progressive files put further tables) and checks every Huffman table before stb sees it: stb 2.27
-// (Debian's) writes past its 257-entry size list when a table's 16 counts add up to more than 256,
-// which the JPEG standard forbids (found by tools/fuzz/fuzz_image.c). Returns NULL or what is wrong.
+// progressive files put further tables) and checks every Huffman table before the decoder sees it: stb
+// 2.27 (Debian's, the JPEG decoder before libjpeg-turbo) wrote past its 257-entry size list when a table's
+// 16 counts add up to more than 256, which the JPEG standard forbids (found by tools/fuzz/fuzz_image.c). Returns NULL or what is wrong.
 static const char *jpeg_tables_bad(const uint8_t *d, size_t len)
 {
     size_t i = 2;  // after SOI
     while (i + 4 <= len) {
-        if (d[i] != 0xff) return "bytes between marker segments";  // stb would resynchronise past them
+        if (d[i] != 0xff) return "bytes between marker segments";  // a decoder would resynchronise past them
         uint8_t m = d[i + 1];
         if (m == 0xff) {  // fill byte
             i++;
@@ -73,22 +78,105 @@ static const char *jpeg_tables_bad(const uint8_t *d, size_t len)
     return NULL;
 }
 
+// libjpeg reports errors through a callback that must not return: it jumps back here with the message.
+typedef struct jpeg_fail {
+    struct jpeg_error_mgr mgr;
+    jmp_buf back;
+    char msg[JMSG_LENGTH_MAX];
+    bool corrupt;  // a warning about damaged data (libjpeg would go on and fill the rest with grey)
+} jpeg_fail;
+
+static void jpeg_error_exit(j_common_ptr j)
+{
+    jpeg_fail *f = (jpeg_fail *)j->err;
+    f->mgr.format_message(j, f->msg);
+    longjmp(f->back, 1);
+}
+
+static void jpeg_emit(j_common_ptr j, int level)
+{
+    jpeg_fail *f = (jpeg_fail *)j->err;
+    // Level -1 is a warning about the data; extraneous bytes before a marker are harmless (cameras).
+    if (level < 0 && f->mgr.msg_code != JWRN_EXTRANEOUS_DATA && !f->corrupt) {
+        f->corrupt = true;
+        f->mgr.format_message(j, f->msg);
+    }
+}
+
 static rs_result decode_jpeg(const uint8_t *data, size_t len, const char *name, rs_image *out, rs_error *err)
 {
     const char *bad = jpeg_tables_bad(data, len);
     if (bad) return rs_fail(err, RS_ERR_FORMAT, "%s: bad JPEG data (%s)", name, bad);
-    if (len > (size_t)INT32_MAX) return rs_fail(err, RS_ERR_LIMIT, "%s: JPEG of %zu bytes is too large", name, len);
+    if (len > (size_t)UINT32_MAX) return rs_fail(err, RS_ERR_LIMIT, "%s: JPEG of %zu bytes is too large", name, len);
+    struct jpeg_decompress_struct j;
+    jpeg_fail f = {0};
+    j.err = jpeg_std_error(&f.mgr);
+    f.mgr.error_exit = jpeg_error_exit;
+    f.mgr.emit_message = jpeg_emit;
+    // volatile: assigned between setjmp and a longjmp back to it.
+    uint8_t *volatile px = NULL;
+    if (setjmp(f.back)) {
+        jpeg_destroy_decompress(&j);
+        free(px);
+        return rs_fail(err, RS_ERR_FORMAT, "%s: bad JPEG data (%s)", name, f.msg);
+    }
+    jpeg_create_decompress(&j);
+    jpeg_mem_src(&j, data, (unsigned long)len);
+    jpeg_read_header(&j, TRUE);
+    uint64_t w = j.image_width, h = j.image_height;
+    rs_result r = RS_OK;
+    if (w < 1 || h < 1 || w > RS_IMAGE_MAX_DIM || h > RS_IMAGE_MAX_DIM)
+        r = rs_fail(err, RS_ERR_LIMIT, "%s: image is %llux%llu, larger than the %d allowed", name, (unsigned long long)w,
+                    (unsigned long long)h, RS_IMAGE_MAX_DIM);
+    else if (w * h > RS_IMPORT_MAX_TEXTURE_PIXELS)
+        r = rs_fail(err, RS_ERR_LIMIT, "%s: image is %llux%llu = %.1f Mpx, more than the %.0f Mpx allowed", name,
+                    (unsigned long long)w, (unsigned long long)h, (double)(w * h) / 1e6, RS_IMPORT_MAX_TEXTURE_PIXELS / 1e6);
+    else if (((w + 7) / 8) * ((h + 7) / 8) > (uint64_t)len * 8 / JPEG_MIN_BITS_PER_BLOCK)
+        r = rs_fail(err, RS_ERR_FORMAT, "%s: header claims %llux%llu pixels but the %zu-byte file cannot hold that much data",
+                    name, (unsigned long long)w, (unsigned long long)h, len);
+    if (r != RS_OK) {
+        jpeg_destroy_decompress(&j);
+        return r;
+    }
+    // Grey and YCbCr both come out as RGB; CMYK cannot (libjpeg says so, as an error).
+    j.out_color_space = JCS_RGB;
+    jpeg_start_decompress(&j);
+    px = malloc((size_t)(w * h * 3));
+    if (!px) {
+        jpeg_destroy_decompress(&j);
+        return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory decoding %llux%llu", name, (unsigned long long)w,
+                       (unsigned long long)h);
+    }
+    while (j.output_scanline < j.output_height) {
+        JSAMPROW row = px + (size_t)j.output_scanline * (size_t)w * 3;
+        jpeg_read_scanlines(&j, &row, 1);
+    }
+    jpeg_finish_decompress(&j);
+    jpeg_destroy_decompress(&j);
+    if (f.corrupt) {
+        free(px);
+        return rs_fail(err, RS_ERR_FORMAT, "%s: bad JPEG data (%s)", name, f.msg);
+    }
+    *out = (rs_image){.width = (int)w, .height = (int)h, .channels = 3, .pixels = px};
+    return RS_OK;
+}
+
+// BMP and TGA through stb_image: the header's size is checked (stbi_info) before any pixel is allocated.
+// Neither format compresses better than 128 pixels per byte (a TGA run-length packet: one count byte and
+// one 8-bit pixel), so a header claiming more than that is a decompression bomb.
+static rs_result decode_stb(const uint8_t *data, size_t len, const char *name, const char *what, rs_image *out, rs_error *err)
+{
+    if (len > (size_t)INT32_MAX) return rs_fail(err, RS_ERR_LIMIT, "%s: %s of %zu bytes is too large", name, what, len);
     int w = 0, h = 0, comp = 0;
     if (!stbi_info_from_memory(data, (int)len, &w, &h, &comp))
-        return rs_fail(err, RS_ERR_FORMAT, "%s: not a readable JPEG file (%s)", name, stbi_failure_reason());
+        return rs_fail(err, RS_ERR_FORMAT, "%s: not a readable %s file (%s)", name, what, stbi_failure_reason());
     if (w < 1 || h < 1 || w > RS_IMAGE_MAX_DIM || h > RS_IMAGE_MAX_DIM)
         return rs_fail(err, RS_ERR_LIMIT, "%s: image is %dx%d, larger than the %d allowed", name, w, h, RS_IMAGE_MAX_DIM);
     uint64_t px = (uint64_t)w * (uint64_t)h;
     if (px > RS_IMPORT_MAX_TEXTURE_PIXELS)
         return rs_fail(err, RS_ERR_LIMIT, "%s: image is %dx%d = %.1f Mpx, more than the %.0f Mpx allowed", name, w, h,
                        px / 1e6, RS_IMPORT_MAX_TEXTURE_PIXELS / 1e6);
-    uint64_t blocks = ((uint64_t)(w + 7) / 8) * ((uint64_t)(h + 7) / 8);
-    if (blocks > (uint64_t)len * 8 / JPEG_MIN_BITS_PER_BLOCK)
+    if (px > (uint64_t)len * 128)
         return rs_fail(err, RS_ERR_FORMAT, "%s: header claims %dx%d pixels but the %zu-byte file cannot hold that much data",
                        name, w, h, len);
     int cw, ch, cc;
@@ -96,7 +184,7 @@ static rs_result decode_jpeg(const uint8_t *data, size_t len, const char *name, 
     if (!px8) {
         const char *why = stbi_failure_reason();
         if (why && !strcmp(why, "outofmem")) return rs_fail(err, RS_ERR_NOMEM, "%s: out of memory decoding %dx%d", name, w, h);
-        return rs_fail(err, RS_ERR_FORMAT, "%s: bad JPEG data (%s)", name, why ? why : "?");
+        return rs_fail(err, RS_ERR_FORMAT, "%s: bad %s data (%s)", name, what, why ? why : "?");
     }
     if (cw != w || ch != h) {
         stbi_image_free(px8);
@@ -107,7 +195,7 @@ static rs_result decode_jpeg(const uint8_t *data, size_t len, const char *name, 
     return RS_OK;
 }
 
-// stb decodes a JPEG cut short as if the rest were zeros (a grey band): refuse files without the
+// libjpeg decodes a JPEG cut short as if the rest were grey (with a warning): refuse files without the
 // end-of-image marker, allowing trailing bytes after it (some cameras append data).
 static bool jpeg_has_end(const uint8_t *d, size_t len)
 {
@@ -139,12 +227,17 @@ static rs_result decode_any(const void *data, size_t len, const char *name, bool
             return rs_fail(err, RS_ERR_FORMAT, "%s: JPEG is truncated (no end-of-image marker in its %zu bytes)", name, len);
         return decode_jpeg(d, len, name, out, err);
     }
-    if (len == 0) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file (empty)", name);
-    if (!quote) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file", name);
+    if (len >= 2 && d[0] == 'B' && d[1] == 'M') return decode_stb(d, len, name, "BMP", out, err);
+    // TGA has no signature: stb's header test (image type, colour map, sizes and depth) decides.
+    int w, h, comp;
+    if (len >= 18 && len <= (size_t)INT32_MAX && stbi_info_from_memory(d, (int)len, &w, &h, &comp))
+        return decode_stb(d, len, name, "TGA", out, err);
+    if (len == 0) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG, JPEG, BMP or TGA file (empty)", name);
+    if (!quote) return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG, JPEG, BMP or TGA file", name);
     char hex[16] = "";
     for (size_t i = 0; i < RS_MIN(len, (size_t)4); i++) snprintf(hex + 3 * i, sizeof hex - 3 * i, "%02x ", d[i]);
     hex[strlen(hex) - 1] = 0;
-    return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG or JPEG file (starts %s)", name, hex);
+    return rs_fail(err, RS_ERR_FORMAT, "%s: not a PNG, JPEG, BMP or TGA file (starts %s)", name, hex);
 }
 
 rs_result rs_image_decode_any(const void *data, size_t len, const char *name, rs_image *out, rs_error *err)

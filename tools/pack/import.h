@@ -1,6 +1,7 @@
 // import.h — the scan formats people have, read into the converter's mesh: PLY through rouge's own reader
 // (ply.h), everything else (OBJ + MTL, glTF / GLB, FBX, STL, DAE, 3DS, OFF, ...) through assimp, plus the
-// texture images their materials name (PNG through libpng, JPEG through stb_image).
+// texture images their materials name (PNG through libpng, JPEG through libjpeg-turbo, BMP / TGA through
+// stb_image).
 //
 // Does: route a file by its content (a "ply" magic line) or its extension; flatten an assimp scene into
 // one triangle mesh (node transforms applied, polygons triangulated, vertices that share position, UV and
@@ -59,6 +60,12 @@ typedef struct rs_import_page {
     char *texture;          // the path as the file names it (relative to the model's folder), or NULL
     const uint8_t *embedded;  // the image file's bytes when the model embeds it (GLB, FBX), or NULL
     size_t embedded_len;
+    // An embedded image handed over as raw texels (assimp's aiTexel, B G R A per pixel) rather than a
+    // file: its size (then embedded_len == 4 * raw_width * raw_height); 0 for an image file.
+    uint32_t raw_width, raw_height;
+    // How texture coordinates outside [0, 1] read the image along u and v (rs_pack_wrap in pack.h):
+    // repeat unless the material says otherwise (AI_MATKEY_MAPPINGMODE_U / _V).
+    uint8_t wrap[2];
     uint8_t *embedded_copy;   // what `embedded` points to when the import ran in a child process
 } rs_import_page;
 
@@ -117,12 +124,17 @@ rs_result rs_import_guard(const void *data, size_t len, rs_import_format format,
 const char *rs_import_format_name(rs_import_format f);
 
 // Decodes every page's texture (embedded bytes, or the file named relative to the model's folder) into
-// *out (page_count images; a page without a texture stays zeroed). A texture that is missing or
-// unreadable is an error naming the material and the file.
-rs_result rs_import_load_pages(const rs_import_scene *s, rs_image **out, rs_error *err);
+// *out (page_count images; a page without a texture stays zeroed). A texture never stops a conversion:
+// one that is missing, refused by the path policy, unreadable or in an unsupported format leaves its page
+// zeroed (the sampler falls back to vertex colours or the default grey) and adds a warning naming the
+// material and the file to warnings[cap] ("; "-joined). Errors: out of memory only.
+// Texture paths: Windows separators and drive letters are accepted ("C:\x\skin.png", "\tex\skin.png"
+// name skin.png, looked for as given below the model's folder, then by its bare name there).
+rs_result rs_import_load_pages(const rs_import_scene *s, rs_image **out, char *warnings, size_t cap, rs_error *err);
 void rs_import_free_pages(rs_image *pages, uint32_t count);
 
-// Texture images (image_load.c): PNG (libpng, src/core/image.c) or JPEG (stb_image), by content. The size
+// Texture images (image_load.c): PNG (libpng, src/core/image.c), JPEG (libjpeg-turbo: baseline and
+// progressive), BMP or TGA (stb_image), by content. The size
 // the header claims is checked (sides, RS_IMPORT_MAX_TEXTURE_PIXELS, and what the file's bytes can encode)
 // before pixels are allocated. `name` is used in messages.
 rs_result rs_image_load_any(const char *path, rs_image *out, rs_error *err);

@@ -7,6 +7,7 @@
 // hardened; assimp's PLY reader drops point clouds' extra properties.
 #define _XOPEN_SOURCE 700  // realpath
 #include "pack/import.h"
+#include "pack/pack.h"
 
 #include <assimp/cfileio.h>
 #include <assimp/cimport.h>
@@ -468,6 +469,17 @@ static rs_result flatten(const struct aiScene *sc, rs_import_scene *s, rs_error 
     return RS_OK;
 }
 
+static void add_warning(rs_ply_mesh *m, const char *w);
+
+// The file name after the last '/' or '\\' (models made on Windows use either).
+static const char *base_name(const char *path)
+{
+    const char *b = path;
+    for (const char *c = path; *c; c++)
+        if (*c == '/' || *c == '\\') b = c + 1;
+    return b;
+}
+
 // Base-colour texture of each material: glTF's baseColorTexture, else the diffuse map (MTL map_Kd, FBX,
 // DAE); embedded images ("*N", or a file name matching an embedded texture's) point into the scene.
 static rs_result collect_pages(const struct aiScene *sc, rs_import_scene *s, rs_error *err)
@@ -483,35 +495,53 @@ static rs_result collect_pages(const struct aiScene *sc, rs_import_scene *s, rs_
         if (mat && aiGetMaterialString(mat, AI_MATKEY_NAME, &name) == aiReturn_SUCCESS)
             snprintf(p->name, sizeof p->name, "%.*s", (int)RS_MIN(name.length, sizeof p->name - 1), name.data);
         struct aiString path = {0};
+        enum aiTextureMapMode mode[3] = {aiTextureMapMode_Wrap, aiTextureMapMode_Wrap, aiTextureMapMode_Wrap};
         bool have = false;
         enum aiTextureType types[2] = {aiTextureType_BASE_COLOR, aiTextureType_DIFFUSE};
         for (int k = 0; k < 2 && !have && mat; k++)
-            have = aiGetMaterialTexture(mat, types[k], 0, &path, NULL, NULL, NULL, NULL, NULL, NULL) == aiReturn_SUCCESS &&
+            have = aiGetMaterialTexture(mat, types[k], 0, &path, NULL, NULL, NULL, NULL, mode, NULL) == aiReturn_SUCCESS &&
                    path.length > 0 && path.length < sizeof path.data;
         if (!have) continue;
+        // Decal (transparent outside [0, 1]) reads as clamp: a splat has no transparency.
+        for (int a = 0; a < 2; a++)
+            p->wrap[a] = mode[a] == aiTextureMapMode_Mirror ? RS_PACK_WRAP_MIRROR
+                         : mode[a] == aiTextureMapMode_Clamp || mode[a] == aiTextureMapMode_Decal ? RS_PACK_WRAP_CLAMP
+                                                                                                   : RS_PACK_WRAP_REPEAT;
         const struct aiTexture *tex = NULL;
         if (path.data[0] == '*') {
             char *end;
             long idx = strtol(path.data + 1, &end, 10);
-            if (end == path.data + 1 || *end || idx < 0 || (unsigned long)idx >= sc->mNumTextures)
-                return rs_fail(err, RS_ERR_FORMAT, "%s: material '%s' names embedded texture '%s', which does not exist",
-                               s->path, p->name, path.data);
+            if (end == path.data + 1 || *end || idx < 0 || (unsigned long)idx >= sc->mNumTextures || !sc->mTextures[idx]) {
+                // Not an error: the conversion goes on without this page's texture (see rs_import_load_pages).
+                char w[160];
+                snprintf(w, sizeof w, "material '%s' names embedded texture '%s', which does not exist: not textured",
+                         p->name, path.data);
+                add_warning(s->mesh, w);
+                continue;
+            }
             tex = sc->mTextures[idx];
         } else {
-            const char *want = strrchr(path.data, '/') ? strrchr(path.data, '/') + 1 : path.data;
+            // FBX embeds images under the file name its materials use (either separator).
+            const char *want = base_name(path.data);
             for (unsigned t = 0; t < sc->mNumTextures && !tex; t++) {
                 const struct aiTexture *c = sc->mTextures[t];
-                if (!c || !c->mFilename.length) continue;
-                const char *fn = strrchr(c->mFilename.data, '/') ? strrchr(c->mFilename.data, '/') + 1 : c->mFilename.data;
-                if (!strcmp(fn, want)) tex = c;
+                if (c && c->mFilename.length && !strcmp(base_name(c->mFilename.data), want)) tex = c;
             }
         }
-        if (tex) {
-            if (tex->mHeight != 0 || !tex->pcData)
-                return rs_fail(err, RS_ERR_FORMAT, "%s: material '%s': embedded texture is raw texels, not a PNG or JPEG file",
-                               s->path, p->name);
+        if (tex && tex->pcData) {
+            // Compressed (an image file's bytes, mWidth of them) or raw aiTexel rows (mWidth x mHeight).
+            uint64_t len = tex->mHeight ? (uint64_t)tex->mWidth * tex->mHeight * sizeof(struct aiTexel) : tex->mWidth;
+            if (tex->mHeight && (tex->mWidth > RS_IMAGE_MAX_DIM || tex->mHeight > RS_IMAGE_MAX_DIM)) {
+                char w[160];
+                snprintf(w, sizeof w, "material '%s': embedded texture of %ux%u texels, larger than the %d allowed: not textured",
+                         p->name, tex->mWidth, tex->mHeight, RS_IMAGE_MAX_DIM);
+                add_warning(s->mesh, w);
+                continue;
+            }
             p->embedded = (const uint8_t *)tex->pcData;
-            p->embedded_len = tex->mWidth;
+            p->embedded_len = (size_t)len;
+            p->raw_width = tex->mHeight ? tex->mWidth : 0;
+            p->raw_height = tex->mHeight;
         } else {
             p->texture = strdup(path.data);
             if (!p->texture) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
@@ -783,6 +813,8 @@ typedef struct wire_head {
 
 typedef struct wire_page {
     char name[64];
+    uint32_t raw_width, raw_height;
+    uint8_t wrap[2];
     uint32_t texture_len;
     uint64_t embedded_len;
 } wire_page;
@@ -837,7 +869,11 @@ static bool send_scene(int fd, rs_result result, const rs_error *e, const rs_imp
               (!m->tri_page || put(fd, m->tri_page, nt * sizeof *m->tri_page)) && put(fd, m->comments, h.comments_len);
     for (uint32_t i = 0; ok && i < s->page_count; i++) {
         const rs_import_page *p = &s->pages[i];
-        wire_page w = {.texture_len = p->texture ? (uint32_t)strlen(p->texture) : 0, .embedded_len = p->embedded_len};
+        wire_page w;
+        memset(&w, 0, sizeof w);  // padding too
+        w.texture_len = p->texture ? (uint32_t)strlen(p->texture) : 0, w.embedded_len = p->embedded_len;
+        w.raw_width = p->raw_width, w.raw_height = p->raw_height;
+        memcpy(w.wrap, p->wrap, sizeof w.wrap);
         memcpy(w.name, p->name, sizeof w.name);
         ok = put(fd, &w, sizeof w) && put(fd, p->texture, w.texture_len) && (!p->embedded || put(fd, p->embedded, p->embedded_len));
     }
@@ -902,6 +938,11 @@ static bool receive_scene(int fd, rs_import_scene *s, rs_result *result, rs_erro
         if (!get(fd, &w, sizeof w) || w.texture_len > 4096 || w.embedded_len > RS_IMPORT_MAX_FILE) return false;
         memcpy(p->name, w.name, sizeof p->name);
         p->name[sizeof p->name - 1] = 0;
+        if (w.raw_width > RS_IMAGE_MAX_DIM || w.raw_height > RS_IMAGE_MAX_DIM || w.wrap[0] > RS_PACK_WRAP_MIRROR ||
+            w.wrap[1] > RS_PACK_WRAP_MIRROR || (w.raw_height && w.embedded_len != (uint64_t)w.raw_width * w.raw_height * 4))
+            return false;
+        p->raw_width = w.raw_width, p->raw_height = w.raw_height;
+        memcpy(p->wrap, w.wrap, sizeof p->wrap);
         if (w.texture_len) {
             p->texture = calloc(w.texture_len + 1, 1);
             if (!p->texture || !get(fd, p->texture, w.texture_len)) return false;
@@ -1068,16 +1109,20 @@ void rs_import_destroy(rs_import_scene *s)
 
 // ---- textures ----
 
-// A texture path from a material: relative to the model's folder; Windows separators are accepted, and
-// when the path does not exist (an absolute path from the machine that made the file) the bare file name
-// next to the model is tried. A path outside the model's folder is not read unless the scene allows it
-// (rs_import_desc): the bare name in the folder is tried instead; errors never quote the file's bytes.
+// A texture path from a material: relative to the model's folder. Windows paths are accepted: '\' is a
+// separator, and a drive letter or a leading separator ("C:\x\skin.png", "\textures\skin.png": where the
+// file lay on the machine that made it) is dropped, so the path is looked for below the model's folder,
+// then the bare file name there. A path outside the model's folder is not read unless the scene allows it
+// (rs_import_desc); errors never quote the file's bytes. Why it failed goes to err (a warning's text).
 static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *p, rs_image *out, rs_error *err)
 {
     char rel[1024];
     snprintf(rel, sizeof rel, "%s", p->texture);
     for (char *c = rel; *c; c++)
         if (*c == '\\') *c = '/';
+    const char *stripped = rel;
+    if (((rel[0] | 0x20) >= 'a' && (rel[0] | 0x20) <= 'z') && rel[1] == ':') stripped += 2;
+    while (*stripped == '/') stripped++;
     char dir[4096];
     snprintf(dir, sizeof dir, "%s", s->path);
     char *slash = strrchr(dir, '/');
@@ -1086,10 +1131,10 @@ static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *
     char folder[4096];
     model_folder(s->path, folder, sizeof folder);
     char full[8192];
-    const char *base = strrchr(rel, '/') ? strrchr(rel, '/') + 1 : rel;
-    const char *tries[2] = {rel, base};
+    const char *tries[3] = {rel, stripped, base_name(rel)};
     bool outside = false;
-    for (int k = 0; k < 2; k++) {
+    for (int k = 0; k < 3; k++) {
+        if (!tries[k][0] || (k > 0 && !strcmp(tries[k], tries[k - 1]))) continue;
         if (tries[k][0] == '/') snprintf(full, sizeof full, "%s", tries[k]);
         else snprintf(full, sizeof full, "%s%s", dir, tries[k]);
         struct stat st;
@@ -1102,37 +1147,67 @@ static rs_result load_page_file(const rs_import_scene *s, const rs_import_page *
         if (r != RS_OK) {
             char why[sizeof err->msg];
             snprintf(why, sizeof why, "%s", err->msg);
-            return rs_fail(err, r, "%s: material '%s': texture %s", s->path, p->name, why);
+            return rs_fail(err, r, "texture %s", why);
         }
         return RS_OK;
     }
     if (outside)
-        return rs_fail(err, RS_ERR_IO, "%s: material '%s' names the texture '%s', outside the model's folder: not read "
-                                       "(rouge-pack --allow-outside-paths reads it, --texture FILE uses another image)",
-                       s->path, p->name, p->texture);
-    return rs_fail(err, RS_ERR_IO, "%s: material '%s' names the texture '%s', which is not there (looked in '%s'); "
-                                   "pass --texture FILE to use another image", s->path, p->name, p->texture, dir[0] ? dir : "./");
+        return rs_fail(err, RS_ERR_IO, "names the texture '%s', outside the model's folder: not read "
+                                       "(--allow-outside-paths reads it, --texture FILE uses another image)", p->texture);
+    return rs_fail(err, RS_ERR_IO, "names the texture '%s', which is not there (looked in '%s'; --texture FILE uses "
+                                   "another image)", p->texture, dir[0] ? dir : "./");
 }
 
-rs_result rs_import_load_pages(const rs_import_scene *s, rs_image **out, rs_error *err)
+// assimp's aiTexel rows (B G R A) as an RGB image.
+static rs_result decode_texels(const rs_import_page *p, rs_image *out, rs_error *err)
+{
+    size_t n = (size_t)p->raw_width * p->raw_height;
+    uint8_t *px = rs_alloc_array(n ? n : 1, 3);
+    if (!px) return rs_fail(err, RS_ERR_NOMEM, "out of memory for a %ux%u texture", p->raw_width, p->raw_height);
+    for (size_t i = 0; i < n; i++)
+        px[3 * i] = p->embedded[4 * i + 2], px[3 * i + 1] = p->embedded[4 * i + 1], px[3 * i + 2] = p->embedded[4 * i];
+    *out = (rs_image){.width = (int)p->raw_width, .height = (int)p->raw_height, .channels = 3, .pixels = px};
+    return RS_OK;
+}
+
+static void append(char *buf, size_t cap, const char *w)
+{
+    if (!buf || !cap) return;
+    size_t len = strnlen(buf, cap - 1);
+    snprintf(buf + len, cap - len, "%s%s", len ? "; " : "", w);
+}
+
+rs_result rs_import_load_pages(const rs_import_scene *s, rs_image **out, char *warnings, size_t cap, rs_error *err)
 {
     *out = NULL;
     if (!s->page_count) return RS_OK;
     rs_image *pages = calloc(s->page_count, sizeof *pages);
     if (!pages) return rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    const char *instead = s->mesh && s->mesh->rgb ? "its vertex colours" : "the default grey";
     for (uint32_t i = 0; i < s->page_count; i++) {
         const rs_import_page *p = &s->pages[i];
+        rs_error e = {0};
         rs_result r = RS_OK;
-        if (p->embedded) {
-            char name[160];
-            snprintf(name, sizeof name, "%s: material '%s': embedded texture", s->path, p->name);
-            r = rs_image_decode_any(p->embedded, p->embedded_len, name, &pages[i], err);
+        if (p->embedded && p->raw_height) {
+            r = decode_texels(p, &pages[i], &e);
+        } else if (p->embedded) {
+            r = rs_image_decode_any(p->embedded, p->embedded_len, "embedded texture", &pages[i], &e);
+        } else if (p->texture && !strcmp(base_name(p->texture), "$texture_dummy.bmp")) {
+            // assimp's stand-in when a format names a skin it could not find (MD2, MD3): nothing to read.
+            r = rs_fail(&e, RS_ERR_FORMAT, "has assimp's placeholder texture '$texture_dummy.bmp' (the file names no "
+                                           "texture assimp found)");
         } else if (p->texture) {
-            r = load_page_file(s, p, &pages[i], err);
+            r = load_page_file(s, p, &pages[i], &e);
+        }
+        if (r == RS_ERR_NOMEM) {
+            rs_import_free_pages(pages, s->page_count);
+            return rs_fail(err, r, "%s: material '%s': %s", s->path, p->name, e.msg);
         }
         if (r != RS_OK) {
-            rs_import_free_pages(pages, s->page_count);
-            return r;
+            rs_image_free(&pages[i]);
+            char w[sizeof e.msg + 192];
+            snprintf(w, sizeof w, "material '%s' %s; coloured from %s instead", p->name, e.msg, instead);
+            append(warnings, cap, w);
         }
     }
     *out = pages;

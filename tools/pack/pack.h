@@ -149,9 +149,15 @@ typedef struct rs_pack_points {
     uint8_t (*rgb)[3];    // NULL when the input has no colour
     uint8_t *region;      // region id or RS_PACK_REGION_AUTO, never NULL
     float *specular;      // specular-map value 0..1 per point, or NULL (measured for the report only)
+    uint32_t default_rgb; // points given the default colour (no texture page or vertex colour where they lie)
 } rs_pack_points;
 
 void rs_pack_points_free(rs_pack_points *p);
+
+// How texture coordinates outside [0, 1] read an image (a material's wrap mode): repeat (tiling, the
+// default of glTF, OBJ and GL), clamp to the edge, or mirrored repeat. Inside [0, 1] every mode samples
+// the same texels.
+typedef enum rs_pack_wrap { RS_PACK_WRAP_REPEAT = 0, RS_PACK_WRAP_CLAMP, RS_PACK_WRAP_MIRROR } rs_pack_wrap;
 
 typedef struct rs_pack_sample_desc {
     uint32_t points;             // samples to draw (0 = RS_PACK_DEFAULT_MESH_POINTS)
@@ -162,6 +168,7 @@ typedef struct rs_pack_sample_desc {
     // when the mesh has no tri_page); a page without pixels falls back to vertex colours.
     const rs_image *pages;
     uint32_t page_count;
+    const uint8_t (*page_wrap)[2];  // per page: rs_pack_wrap along u and v (NULL: every page repeats)
     const rs_image *normal_map;  // tangent space, OpenGL convention (+G along +t)
     const rs_image *specular_map;
     const rs_image *region_map;  // UV-space region codes (see rs_pack_region_from_rgb)
@@ -253,6 +260,7 @@ typedef struct rs_pack_desc {
     const rs_image *texture, *normal_map, *specular_map, *region_map;  // need texture coordinates
     const rs_image *pages;        // mesh: per-material colour pages when texture is NULL (see sampling)
     uint32_t page_count;
+    const uint8_t (*page_wrap)[2];  // per page: rs_pack_wrap along u, v (NULL: repeat; other maps repeat)
     float mm_per_unit;            // 0 = the scale rule above (declared, inferred or estimated)
     float declared_mm_per_unit;   // the unit the input file declares (0 = none), and why ("glTF: metres")
     const char *declared_unit;
@@ -269,12 +277,14 @@ typedef struct rs_pack_report {
     uint32_t triangles_dropped;   // outside the largest component
     uint32_t duplicates_dropped;  // points at the same position as another
     uint32_t splats;
+    uint32_t colour_default_points;  // samples given the default grey (all when colour_default)
     bool sampled_mesh, normals_estimated, colour_default, mm_estimated;  // mm_estimated: scale == ESTIMATED
     rs_pack_scale scale;          // which rule set mm_per_unit, and in words why
     char scale_why[256];
     uint32_t normals_replaced;  // input normals that were zero or not finite, re-estimated (0: all usable)
     uint32_t regions_given;       // splats whose region came from the input (map or PLY property)
     rs_pack_face face;
+    bool face_rejected;           // a face was found but its frame was not finite: converted as no face
     float specular_mean[RS_SPLAT_MAX_REGIONS];  // mean specular-map value per region, NAN without a map
     double seconds[RS_PACK_STEP_COUNT];
 } rs_pack_report;
@@ -283,6 +293,9 @@ typedef struct rs_pack_report {
 // the sphere from which nothing of the cloud hides the splat, q/255. A few seconds for 600k splats.
 #define RS_PACK_AO_DIRS 96
 rs_result rs_pack_ao(const rs_splat *splats, uint32_t n, uint8_t *ao, rs_error *err);
+// The same with only splats[0..occluders) drawn as occluders, their radii scaled by sqrt(n / occluders)
+// (an LOD prefix: an even subsample covering the same surface); every splat is tested.
+rs_result rs_pack_ao_prefix(const rs_splat *splats, uint32_t n, uint32_t occluders, uint8_t *ao, rs_error *err);
 // The same for a cloud's splats as the file stores them (quantised), set into it (RS_SPLAT_FLAG_AO):
 // converting and `rouge-pack --ao` on the result give the same bytes.
 rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err);

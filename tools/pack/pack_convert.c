@@ -251,6 +251,39 @@ static float choose_scale(const rs_pack_desc *d, const rs_pack_face *f, rs_pack_
     return mm;
 }
 
+static bool all_finite(const float *v, int k)
+{
+    for (int i = 0; i < k; i++)
+        if (!isfinite(v[i])) return false;
+    return true;
+}
+
+static bool face_finite(const rs_pack_face *f)
+{
+    return all_finite(f->up, 3) && all_finite(f->forward, 3) && all_finite(f->side, 3) && all_finite(f->top, 3) &&
+           all_finite(f->nose_tip, 3) && all_finite(f->mouth, 3) && all_finite(f->mouth_corner[0], 6) &&
+           all_finite(f->chin, 3) && all_finite(f->centre, 3) && isfinite(f->brow_y) && isfinite(f->face_height) &&
+           f->face_height > 0 && isfinite(f->face_width);
+}
+
+// No face: the frame rs_pack_find_face gives a model without one (+Y up, +Z forward where its own axes
+// are not finite; the bounding box's centre, its diagonal for the height).
+static void unframe(rs_pack_face *f, const float (*pos)[3], uint32_t n)
+{
+    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) mn[a] = fminf(mn[a], pos[i][a]), mx[a] = fmaxf(mx[a], pos[i][a]);
+    rs_pack_face g = {0};
+    bool axes = all_finite(f->up, 3) && all_finite(f->forward, 3) && all_finite(f->side, 3);
+    memcpy(g.up, axes ? f->up : (const float[3]){0, 1, 0}, sizeof g.up);
+    memcpy(g.forward, axes ? f->forward : (const float[3]){0, 0, 1}, sizeof g.forward);
+    memcpy(g.side, axes ? f->side : (const float[3]){1, 0, 0}, sizeof g.side);
+    for (int a = 0; a < 3; a++) g.centre[a] = 0.5f * (mn[a] + mx[a]);
+    g.face_height = (float)hypot(hypot((double)mx[0] - mn[0], (double)mx[1] - mn[1]), (double)mx[2] - mn[2]);
+    if (!(g.face_height > 0) || !isfinite(g.face_height)) g.face_height = 1.0f;
+    *f = g;
+}
+
 rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_splat_cloud **out,
                           rs_pack_report *report, rs_error *err)
 {
@@ -301,6 +334,7 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     if (in->tri && in->tri_count > 0) {
         rs_pack_sample_desc sd = {.points = d->points, .seed = d->seed, .all_components = d->all_components,
                                   .texture = d->texture, .pages = d->pages, .page_count = d->page_count,
+                                  .page_wrap = d->page_wrap,
                                   .normal_map = d->normal_map,
                                   .specular_map = d->specular_map, .region_map = d->region_map};
         r = rs_pack_sample_mesh(in, &sd, &p, &rep->triangles_dropped, err);
@@ -398,6 +432,12 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
     for (uint32_t i = 0; i < n; i++) rep->regions_given += p.region[i] != RS_PACK_REGION_AUTO;
     r = rs_pack_find_face((const float(*)[3])p.pos, (const float(*)[3])p.normal, n, d->up, d->forward, &rep->face, err);
     if (r != RS_OK) goto out;
+    if (rep->face.found && !face_finite(&rep->face)) {
+        // A face whose landmarks are not finite (seen on a spider and an engine part) is no face: the
+        // model is framed by its bounds, without face regions, and the caller says so.
+        unframe(&rep->face, (const float(*)[3])p.pos, n);
+        rep->face_rejected = true;
+    }
     rs_pack_segment((const float(*)[3])p.pos, (const float(*)[3])p.normal, n, &rep->face, p.region);
     if (p.specular) {
         double sum[RS_SPLAT_MAX_REGIONS] = {0};
@@ -417,7 +457,9 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
         r = rs_fail(err, RS_ERR_NOMEM, "out of memory for %u splats", n);
         goto out;
     }
-    rep->colour_default = !p.rgb;
+    // Colour from the input only where some point got it (pages that failed to load colour nothing).
+    rep->colour_default = !p.rgb || p.default_rgb == p.count;
+    rep->colour_default_points = p.rgb ? p.default_rgb : p.count;
     for (uint32_t j = 0; j < n; j++) {
         uint32_t i = order[j];
         rs_splat *s = &splats[j];

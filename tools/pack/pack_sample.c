@@ -59,10 +59,27 @@ static bool normalize3(float v[3])
     return true;
 }
 
-// Texel (s W, (1 - t) H) counted from the top row, bilinear between texel centres, clamped to the edge:
-// the PLY's t = 0 is the bottom row of the image (OpenGL convention, data README).
-static void sample_bilinear(const rs_image *img, float s, float t, float out[3])
+// A coordinate outside [0, 1] brought inside by the wrap mode (tiling UVs: the glTF BoxTextured sample runs
+// 0..6); inside, every mode is the identity, so scans' atlases sample exactly as before.
+static float wrap_coord(float s, uint8_t mode)
 {
+    if (s >= 0.0f && s <= 1.0f) return s;
+    if (!isfinite(s)) return 0.0f;
+    if (mode == RS_PACK_WRAP_CLAMP) return RS_CLAMP(s, 0.0f, 1.0f);
+    if (mode == RS_PACK_WRAP_MIRROR) {
+        float f = s - 2.0f * floorf(s * 0.5f);
+        return f > 1.0f ? 2.0f - f : f;
+    }
+    return s - floorf(s);
+}
+
+static const uint8_t wrap_repeat[2] = {RS_PACK_WRAP_REPEAT, RS_PACK_WRAP_REPEAT};
+
+// Texel (s W, (1 - t) H) counted from the top row, bilinear between texel centres, clamped to the edge
+// after the wrap mode: the PLY's t = 0 is the bottom row of the image (OpenGL convention, data README).
+static void sample_bilinear(const rs_image *img, const uint8_t wrap[2], float s, float t, float out[3])
+{
+    s = wrap_coord(s, wrap[0]), t = wrap_coord(t, wrap[1]);
     float x = s * img->width - 0.5f, y = (1.0f - t) * img->height - 0.5f;
     x = RS_CLAMP(x, 0.0f, (float)(img->width - 1));
     y = RS_CLAMP(y, 0.0f, (float)(img->height - 1));
@@ -80,6 +97,7 @@ static void sample_bilinear(const rs_image *img, float s, float t, float out[3])
 
 static void sample_nearest(const rs_image *img, float s, float t, uint8_t out[3])
 {
+    s = wrap_coord(s, RS_PACK_WRAP_REPEAT), t = wrap_coord(t, RS_PACK_WRAP_REPEAT);
     // Clamped as floats first: out-of-range (or NaN) UVs must not reach an int conversion.
     int x = (int)RS_CLAMP(floorf(s * img->width), 0.0f, (float)(img->width - 1));
     int y = (int)RS_CLAMP(floorf((1.0f - t) * img->height), 0.0f, (float)(img->height - 1));
@@ -313,7 +331,7 @@ rs_result rs_pack_sample_mesh(const rs_ply_mesh *m, const rs_pack_sample_desc *d
                 cross3(nrm, T, B);
                 for (int a = 0; a < 3; a++) B[a] *= h < 0 ? -1.0f : 1.0f;
                 // Tangent-space normal n = rgb / 255 * 2 - 1, OpenGL convention: R along +s, G along +t.
-                sample_bilinear(d->normal_map, uv[0], uv[1], ts);
+                sample_bilinear(d->normal_map, wrap_repeat, uv[0], uv[1], ts);
                 for (int a = 0; a < 3; a++) ts[a] = ts[a] / 255.0f * 2.0f - 1.0f;
                 float pn[3];
                 for (int a = 0; a < 3; a++) pn[a] = ts[0] * T[a] + ts[1] * B[a] + ts[2] * nrm[a];
@@ -322,23 +340,26 @@ rs_result rs_pack_sample_mesh(const rs_ply_mesh *m, const rs_pack_sample_desc *d
         }
         memcpy(p.normal[s], nrm, sizeof nrm);
         const rs_image *colour = d->texture;
+        const uint8_t *wrap = wrap_repeat;
         if (paged) {
             uint32_t pg = m->tri_page ? m->tri_page[lo] : 0;
             colour = pg < d->page_count && d->pages[pg].pixels ? &d->pages[pg] : NULL;
+            if (colour && d->page_wrap) wrap = d->page_wrap[pg];
         }
         if (colour) {
             float c[3];
-            sample_bilinear(colour, uv[0], uv[1], c);
+            sample_bilinear(colour, wrap, uv[0], uv[1], c);
             for (int a = 0; a < 3; a++) p.rgb[s][a] = (uint8_t)lrintf(RS_CLAMP(c[a], 0.0f, 255.0f));
         } else if (m->rgb) {
             for (int a = 0; a < 3; a++)
                 p.rgb[s][a] = (uint8_t)lrintf(w[0] * m->rgb[i[0]][a] + w[1] * m->rgb[i[1]][a] + w[2] * m->rgb[i[2]][a]);
         } else if (p.rgb) {
             p.rgb[s][0] = RS_PACK_DEFAULT_RGB_R, p.rgb[s][1] = RS_PACK_DEFAULT_RGB_G, p.rgb[s][2] = RS_PACK_DEFAULT_RGB_B;
+            p.default_rgb++;
         }
         if (d->specular_map) {
             float c[3];
-            sample_bilinear(d->specular_map, uv[0], uv[1], c);
+            sample_bilinear(d->specular_map, wrap_repeat, uv[0], uv[1], c);
             p.specular[s] = (c[0] + c[1] + c[2]) / (3.0f * 255.0f);
         }
         p.region[s] = RS_PACK_REGION_AUTO;

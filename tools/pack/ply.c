@@ -428,6 +428,10 @@ static rs_result read_header(ply_reader *r)
         } else if (strcmp(e->name, "face") == 0) {
             if ((res = resolve_face(r, e)) != RS_OK) return res;
             r->face = e;
+        } else if (strcmp(e->name, "tristrips") == 0 && e->count > 0) {
+            // Read without them, a strip-only mesh (Cyberware's Igea) would silently become a point cloud.
+            return fail(r, RS_ERR_FORMAT, "element tristrips: triangle strips are not read; convert them to a face list "
+                                          "first (e.g. MeshLab: File > Export Mesh As... PLY)");
         }
         for (uint32_t k = 0; k < e->prop_count; k++) {
             ply_prop *p = &r->props[e->first_prop + k];
