@@ -603,7 +603,7 @@ if selected viewer_compare_and_export_do_what_they_say; then
     elif [ "$(val c1 split_left)" != "Look 1" ] || [ "$(val c2 split) $(val c2 split_left)" != "1 (bare)" ]; then
         echo "FAIL - $name: compare showed '$(val c1 split_left)', then B showed split $(val c2 split) with '$(val c2 split_left)' (want Look 1, then 1 (bare))"
     elif [ "$(val c3 save_dialog)" != 0 ]; then echo "FAIL - $name: the export dialog stayed up after Enter"
-    elif ! val c4 toast | grep -q "Exported $d/rouge-0001.png (look: rouge-0001.look)"; then
+    elif ! val c4 toast | grep -qF "Exported $(cd "$d" && pwd)/rouge-0001.png (look: rouge-0001.look)"; then
         echo "FAIL - $name: the export did not say where: '$(val c4 toast)'"
     elif ! grep -q '^cosmetic' "$d/rouge-0001.look" 2>/dev/null; then echo "FAIL - $name: no look beside the export"
     else
