@@ -4,7 +4,10 @@
 // DOES:
 //   - load a face (.rsf, from a file, memory, or a rouge_stream still arriving: a preview of its coarse LOD
 //     levels first) into a rouge_face that owns the splat cloud, the renderer, the makeup layer and the
-//     painting session;
+//     painting session, reporting progress to a callback that may cancel; lighting environments from
+//     the bundled files, a .rse path, or memory (rouge_face_add_environment);
+//   - render through its own orbit camera or the view and projection matrices of yours, at a pixel
+//     ratio of your window units (pointer events stay in your window's coordinates);
 //   - render it into your current GLES 3.0 context: into the framebuffer you have bound (rouge_face_draw),
 //     or into an RGBA8 texture it owns (rouge_face_render + rouge_face_texture); every GL state it
 //     touches (framebuffers, viewport, program, VAO, buffers, textures, blend/depth/scissor/stencil/cull,
@@ -13,7 +16,8 @@
 //     change what it draws or reads;
 //   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
 //     through an ID buffer, one- and two-finger navigation; brush, eraser, mirror, undo / redo / clear;
-//   - save and load looks (the makeup) as files or memory, show a second look beside the painted one;
+//   - save and load looks (the makeup) as files or memory, list the products in one (look_info), show a
+//     second look beside the painted one;
 //     custom products (colour, finish, coverage) on the brush; record and replay stroke files;
 //   - report capabilities of a context you made (rouge_query_caps), picks and statistics.
 // DOES NOT:
@@ -103,6 +107,7 @@ typedef enum rouge_result {
     ROUGE_ERR_NOMEM,   // out of memory
     ROUGE_ERR_GL,      // no current GLES 3 context, shader or framebuffer failure
     ROUGE_ERR_ARG,     // bad argument (unknown cosmetic, view out of range, ...)
+    ROUGE_ERR_CANCELLED, // the host's progress callback returned false (rouge_face_desc.progress)
 } rouge_result;
 
 // The detail of a failure: "face.rsf: header: bad CRC (byte 8)". Untouched on success.
@@ -202,6 +207,23 @@ typedef struct rouge_view {
     int kernel_count;            // mobile: Gaussians of the subsurface profile (2..4); 0 = 3
     float lod_density;           // mobile: visible splats per face pixel; 0 = 0.3
     rouge_primitive primitive;   // how splats are rasterised (a debugging choice; both agree)
+    // Render pixels per window unit (a browser's devicePixelRatio, a desktop's content scale); 0 = 1,
+    // else 0.1..16. Pointer events, rouge_face_pick, rouge_face_pan and rouge_face_zoom_at take window
+    // units: pixels of the last frame divided by the pixel_ratio that frame was rendered with, so a host
+    // passes its events as they come while width and height are its framebuffer's pixels.
+    float pixel_ratio;
+    // The host's camera: view_matrix and proj_matrix replace the orbit camera (yaw, pitch, zoom, fov, pan)
+    // for rendering and picking. Column-major like glUniformMatrix4fv with transpose GL_FALSE. view_matrix:
+    // model -> eye, rigid (rotation + translation: lengths stay model units; rouge_face_camera_matrices
+    // gives rouge's own as a start); proj_matrix: eye -> clip, a perspective projection (last row 0 0 -1 0,
+    // as glm_perspective / glFrustum make it) whose aspect is the frame's. While set, pointer gestures only
+    // report (as with manual_navigation) and orbit / pan / zoom_at / target move the orbit camera, which
+    // comes back when use_matrices is cleared. Stroke recordings store the orbit camera: strokes painted
+    // through host matrices do not replay where they were painted. Checked at set_view: every number
+    // finite, the view rigid, the projection a perspective with near > 0 (ROUGE_ERR_ARG names the field).
+    bool use_matrices;
+    float view_matrix[16];
+    float proj_matrix[16];
 } rouge_view;
 
 // The bundled lighting environments ("studio", "daylight", ...) a view's env may name, then "paper";
@@ -228,6 +250,13 @@ typedef struct rouge_face_desc {
                                  // the prefix its lib/ (or a static host's bin/) is in, wherever it was
                                  // installed, or assets/env of the source tree whose build/ holds it;
                                  // last the PREFIX it was built for. Never the working directory.
+    // Called (when not NULL) on the creating thread as create goes, with the fraction done: 0 at the
+    // start, then after each stage (the splats parsed and decoded, uploaded with the shaders compiled,
+    // the makeup layer made, the environment uploaded), 1 last; never decreasing. Returning false cancels:
+    // create frees what it made and returns ROUGE_ERR_CANCELLED ("cancelled"), *out untouched. It must not
+    // call rouge on this face (there is none yet).
+    bool (*progress)(void *user, float fraction);
+    void *progress_user;         // handed to progress
 } rouge_face_desc;
 
 // Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
@@ -258,6 +287,15 @@ void rouge_stream_destroy(rouge_stream *s);  // NULL is fine; faces made from it
 // With the creating context current (else its GL objects are leaked, not deleted). NULL is fine.
 void rouge_face_destroy(rouge_face *face);
 
+// A lighting environment from memory (a host without files: the browser): the bytes of a .rse file
+// (tools/env; parsed and checked now, not kept) under `name`, which a view's env then names. 1..63 bytes,
+// not "paper"; it goes before the bundled names and files of that name. Adding a name again replaces it
+// (a view using it is relit at once: its context must be current then). ROUGE_ERR_FORMAT for bytes that
+// are no environment, ROUGE_ERR_LIMIT past 16 names; the face's environments stay as they were then.
+#define ROUGE_MAX_ENVIRONMENTS 16
+rouge_result rouge_face_add_environment(rouge_face *face, const char *name, const void *rse, size_t size,
+                                        rouge_error *err);
+
 // The view (copied, also the env string). ROUGE_ERR_ARG for an unknown mode, pipeline or environment,
 // a size over ROUGE_VIEW_MAX_SIZE, kernel_count outside 2..4, any number NaN, infinite or beyond +-1e6
 // (the message names the field: "view.yaw_deg is NaN"); ROUGE_ERR_IO / ROUGE_ERR_FORMAT for an
@@ -270,10 +308,16 @@ rouge_view rouge_face_get_view(const rouge_face *face);
 // (0 = 0.4). A region on both sides of the face is framed on the side facing the camera more.
 // ROUGE_ERR_ARG for a name the face does not have (the message lists those it has).
 rouge_result rouge_face_target(rouge_face *face, const char *region, float fill, rouge_error *err);
-// Navigation in pixels of the last frame (what gestures do; for keys, wheels and your own gestures).
+// Navigation in window units of the last frame (its pixels / its view's pixel_ratio; what gestures do;
+// for keys, wheels and your own gestures). With view.use_matrices they move only the orbit camera.
 void rouge_face_orbit(rouge_face *face, float yaw_deg, float pitch_deg);
-void rouge_face_pan(rouge_face *face, float dx_px, float dy_px);
-void rouge_face_zoom_at(rouge_face *face, float factor, float x_px, float y_px);  // keeps (x, y) in place
+void rouge_face_pan(rouge_face *face, float dx, float dy);
+void rouge_face_zoom_at(rouge_face *face, float factor, float x, float y);  // keeps (x, y) in place
+// The camera of the last frame (before any: the view at its own size) as GL matrices, column-major:
+// model -> eye and eye -> clip. The orbit camera's, or the host's with view.use_matrices. A host starts
+// its own camera from them, or places its own objects over the face. Both may not be NULL.
+rouge_result rouge_face_camera_matrices(rouge_face *face, float view_matrix[16], float proj_matrix[16],
+                                        rouge_error *err);
 
 // --- drawing -------------------------------------------------------------------------------------------
 
@@ -311,10 +355,11 @@ typedef enum rouge_pointer_type {
 typedef struct rouge_pointer_event {
     rouge_pointer_type type;
     int id;            // the touch / pointer id; two ids down at once pinch and pan
-    float x, y;        // pixels of the last frame, origin its top-left: the frame of the latest draw or
-                       // render, whichever came last (a draw's frame covers its rectangle: subtract the
-                       // rectangle's top-left and scale by view size / rectangle size when they differ);
-                       // before any frame, the view's size (0 = 512 x 512)
+    float x, y;        // window units of the last frame, origin its top-left: its pixels divided by its
+                       // view's pixel_ratio (1: pixels). The frame of the latest draw or render, whichever
+                       // came last (a draw's frame covers its rectangle: subtract the rectangle's top-left
+                       // and scale by view size / rectangle size when they differ); before any frame, the
+                       // view's size (0 = 512 x 512) and pixel_ratio
     float pressure;    // 0..1; 0 = 1 (a mouse)
     double time_s;     // any monotonic clock, seconds
 } rouge_pointer_event;
@@ -323,8 +368,8 @@ typedef struct rouge_pointer_result {
     uint32_t stamps;                 // brush stamps applied
     uint32_t misses;                 // stamps that fell on the background
     bool stroke_begin, stroke_end, stroke_cancel;
-    float orbit_dx, orbit_dy;        // one-finger drag when not painting, pixels
-    float pan_dx, pan_dy;            // two-finger drag, pixels
+    float orbit_dx, orbit_dy;        // one-finger drag when not painting, window units (as x, y)
+    float pan_dx, pan_dy;            // two-finger drag, window units
     float zoom, zoom_x, zoom_y;      // pinch factor (1 = none) and centre
 } rouge_pointer_result;
 
@@ -387,6 +432,21 @@ rouge_result rouge_face_clear(rouge_face *face, rouge_error *err);  // undoable
 
 // --- looks and stroke files -------------------------------------------------------------------------------
 
+// One product of the current look (the makeup as painted now: undone strokes are not in it).
+typedef struct rouge_look_item {
+    char name[32];               // as a look file names it: "lipstick_satin", "custom_blush"
+    const char *kind;            // "lipstick", ... (static)
+    uint8_t rgb[3];              // sRGB
+    rouge_finish finish;         // the family nearest to its finish (never DEFAULT)
+    float coverage;              // sheer 0..1 opaque
+    uint32_t stamps;             // brush stamps of it in the look (mirror images count)
+} rouge_look_item;
+
+// The products of the current look, in the order they were first painted: *count is how many there are;
+// the first min(capacity, *count) are written to items (NULL when capacity is 0). Erasers are no product.
+rouge_result rouge_face_look_info(const rouge_face *face, rouge_look_item *items, int capacity, int *count,
+                                  rouge_error *err);
+
 // Replaces the makeup with the look's and clears undo and redo (loading is not undoable). A look that
 // cannot be read or parsed, or was made on another face, leaves the makeup and undo as they were.
 rouge_result rouge_face_load_look(rouge_face *face, const char *path, rouge_error *err);
@@ -416,10 +476,11 @@ typedef struct rouge_pick {
     uint32_t splat;              // index in the face's cloud
     float position[3];           // the surface point under the pixel, model units
     int region;                  // 0 other, 1 cheek, 2 nose, 3 forehead, 4 lips, ...
-    float brush_radius_px;       // the current brush's radius on screen at that point
+    float brush_radius_px;       // the current brush's radius on screen at that point, window units (as x, y)
 } rouge_pick;
 
-// The face under pixel (x, y) of the last frame (top-left origin); false on background.
+// The face under (x, y) of the last frame, window units as a pointer event's (top-left origin); false on
+// background.
 bool rouge_face_pick(rouge_face *face, float x, float y, rouge_pick *out);
 
 #define ROUGE_MAX_LODS 24

@@ -35,6 +35,9 @@ _Static_assert(ROUGE_MAX_LODS == RS_SPLAT_MAX_LODS, "ROUGE_MAX_LODS");
 _Static_assert((int)ROUGE_COMPOSITE_PHYSICAL == (int)RS_COMPOSITE_PHYSICAL, "rouge_composite");
 _Static_assert(sizeof(((rouge_error *)0)->msg) == sizeof(((rs_error *)0)->msg), "rouge_error");
 _Static_assert(ROUGE_VIEW_MAX_SIZE == RS_VIEW_MAX_SIZE_PX, "ROUGE_VIEW_MAX_SIZE");
+_Static_assert(sizeof(((rouge_look_item *)0)->name) == RS_COSMETIC_NAME_MAX, "rouge_look_item");
+// The library's own codes stop before the one only the public API has.
+_Static_assert((int)ROUGE_ERR_CANCELLED == (int)RS_ERR_ARG + 1, "ROUGE_ERR_CANCELLED");
 
 #define ROUGE_ENV_MAX 64
 #define ROUGE_DEFAULT_SIZE 512
@@ -42,6 +45,8 @@ _Static_assert(ROUGE_VIEW_MAX_SIZE == RS_VIEW_MAX_SIZE_PX, "ROUGE_VIEW_MAX_SIZE"
 #define PITCH_LIMIT_DEG 80.0f
 #define ZOOM_MIN 0.3f
 #define ZOOM_MAX 12.0f
+#define PIXEL_RATIO_MIN 0.1f
+#define PIXEL_RATIO_MAX 16.0f
 #define MAX_TEXTURE_UNITS 8  // the renderer uses units 0..RS_UNIT_LEVEL (render_internal.h)
 
 // A stroke recording is rewritten whole after each stroke (temp file, fsync, rename: the file on disk is
@@ -158,6 +163,7 @@ struct rouge_face {
     char view_env[ROUGE_ENV_MAX]; // view.env points here
     char *env_dir;                // rouge_face_desc.env_dir
     rs_view frame_view;           // the view of the last frame: pointer coordinates and picks refer to it
+    float frame_ratio;            // its pixel_ratio: pointer coordinates * frame_ratio = its pixels
     bool have_frame;
     bool changed;                 // view or makeup changed since the last frame
     bool manual_navigation, painting;
@@ -173,6 +179,11 @@ struct rouge_face {
     rs_file_id source;
     GLuint srgb_tex, srgb_pbo;    // draw into an sRGB framebuffer: the frame's bytes as sRGB texels
     int srgb_w, srgb_h;
+    struct {                      // environments from memory (rouge_face_add_environment)
+        char name[ROUGE_ENV_MAX];
+        rs_env *env;
+    } envs[ROUGE_MAX_ENVIRONMENTS];
+    int env_count;
 };
 
 // A file arriving piece by piece: the splat loader behind a lock (one thread feeds, the GL thread makes
@@ -211,7 +222,8 @@ static rs_result refuse_source(const rouge_face *f, const char *path, rs_error *
 const char *rouge_result_name(rouge_result r)
 {
     static const char *const names[] = {"ROUGE_OK", "ROUGE_ERR_IO", "ROUGE_ERR_FORMAT", "ROUGE_ERR_LIMIT",
-                                        "ROUGE_ERR_NOMEM", "ROUGE_ERR_GL", "ROUGE_ERR_ARG"};
+                                        "ROUGE_ERR_NOMEM", "ROUGE_ERR_GL", "ROUGE_ERR_ARG",
+                                        "ROUGE_ERR_CANCELLED"};
     return (unsigned)r < RS_COUNT_OF(names) ? names[r] : "ROUGE_ERR_?";
 }
 
@@ -520,8 +532,15 @@ static rs_view to_rs_view(const rouge_view *p, int w, int h)
     v.kernel_count = p->kernel_count;
     v.lod_density = p->lod_density;
     v.prim = (rs_splat_prim)p->primitive;
+    v.use_matrices = p->use_matrices;
+    if (p->use_matrices) {
+        memcpy(v.view_matrix, p->view_matrix, sizeof v.view_matrix);
+        memcpy(v.proj_matrix, p->proj_matrix, sizeof v.proj_matrix);
+    }
     return v;
 }
+
+static float ratio_of(const rouge_view *v) { return v->pixel_ratio > 0 ? v->pixel_ratio : 1.0f; }
 
 // The frame pointer coordinates refer to: the last one, or (before any) the view at its own size.
 static const rs_view *pointer_view(rouge_face *f)
@@ -530,6 +549,7 @@ static const rs_view *pointer_view(rouge_face *f)
         int w = f->view.width > 0 ? f->view.width : ROUGE_DEFAULT_SIZE;
         int h = f->view.height > 0 ? f->view.height : ROUGE_DEFAULT_SIZE;
         f->frame_view = to_rs_view(&f->view, w, h);
+        f->frame_ratio = ratio_of(&f->view);
     }
     return &f->frame_view;
 }
@@ -542,6 +562,34 @@ static void camera_changed(rouge_face *f)
     f->frame_view.zoom = f->view.zoom > 0 ? f->view.zoom : 1.0f;
     f->frame_view.pan[0] = f->view.pan[0], f->frame_view.pan[1] = f->view.pan[1];
     f->changed = true;
+}
+
+// The host's camera (view.use_matrices): finite; the view matrix rigid (the renderer measures lengths in
+// model units through it), the projection a perspective one (near and far follow from it). Column-major:
+// m[col * 4 + row].
+static rs_result check_matrices(const rouge_view *v, rs_error *e)
+{
+    const float *m = v->view_matrix, *p = v->proj_matrix;
+    for (int i = 0; i < 32; i++) {
+        float x = i < 16 ? m[i] : p[i - 16];
+        if (!isfinite(x))
+            return rs_fail(e, RS_ERR_ARG, "view.%s[%d] is %g", i < 16 ? "view_matrix" : "proj_matrix", i % 16, x);
+    }
+    for (int c = 0; c < 3; c++)
+        for (int d = 0; d <= c; d++) {
+            float dot = m[c * 4] * m[d * 4] + m[c * 4 + 1] * m[d * 4 + 1] + m[c * 4 + 2] * m[d * 4 + 2];
+            if (fabsf(dot - (c == d ? 1.0f : 0.0f)) > 1e-3f)
+                return rs_fail(e, RS_ERR_ARG, "view.view_matrix is not rigid (columns %d and %d: dot %g)", d, c, dot);
+        }
+    if (fabsf(m[3]) > 1e-6f || fabsf(m[7]) > 1e-6f || fabsf(m[11]) > 1e-6f || fabsf(m[15] - 1.0f) > 1e-6f)
+        return rs_fail(e, RS_ERR_ARG, "view.view_matrix: last row is not 0 0 0 1");
+    if (fabsf(p[3]) > 1e-6f || fabsf(p[7]) > 1e-6f || fabsf(p[11] + 1.0f) > 1e-6f || fabsf(p[15]) > 1e-6f)
+        return rs_fail(e, RS_ERR_ARG, "view.proj_matrix: not a perspective projection (last row must be 0 0 -1 0)");
+    float near_z = p[14] / (p[10] - 1.0f), far_z = p[14] / (p[10] + 1.0f);
+    if (!(p[0] > 0) || !(p[5] > 0) || !(near_z > 0) || !(far_z > near_z) || !isfinite(far_z))
+        return rs_fail(e, RS_ERR_ARG, "view.proj_matrix: no perspective with near > 0 (near %g, far %g, focal %g %g)",
+                       near_z, far_z, p[0], p[5]);
+    return RS_OK;
 }
 
 // Every field of a view the renderer would refuse later, named: a bad view fails at set_view (the
@@ -590,7 +638,59 @@ static rs_result check_view(const rouge_view *v, rs_error *e)
     if (v->fov_deg != 0 && !(v->fov_deg >= RS_VIEW_FOV_MIN_DEG && v->fov_deg <= RS_VIEW_FOV_MAX_DEG))
         return rs_fail(e, RS_ERR_ARG, "view.fov_deg %g is outside %g..%g (0 = 30)", v->fov_deg, RS_VIEW_FOV_MIN_DEG,
                        RS_VIEW_FOV_MAX_DEG);
-    return RS_OK;
+    if (isnan(v->pixel_ratio) || (v->pixel_ratio != 0 && !(v->pixel_ratio >= PIXEL_RATIO_MIN && v->pixel_ratio <= PIXEL_RATIO_MAX)))
+        return rs_fail(e, RS_ERR_ARG, "view.pixel_ratio %g is outside %g..%g (0 = 1)", v->pixel_ratio, PIXEL_RATIO_MIN,
+                       PIXEL_RATIO_MAX);
+    return v->use_matrices ? check_matrices(v, e) : RS_OK;
+}
+
+// An environment the host added from memory, or NULL.
+static const rs_env *face_env(const rouge_face *f, const char *name)
+{
+    for (int i = 0; i < f->env_count; i++)
+        if (!strcmp(f->envs[i].name, name)) return f->envs[i].env;
+    return NULL;
+}
+
+rouge_result rouge_face_add_environment(rouge_face *f, const char *name, const void *rse, size_t size,
+                                        rouge_error *err)
+{
+    rs_error e = {0};
+    if (!f) return fail_arg(err, "environment: no face");
+    if (!name || !name[0] || strlen(name) >= ROUGE_ENV_MAX || rs_env_is_paper(name))
+        return fail_arg(err, "environment: the name must be 1..63 bytes and not \"paper\"");
+    if (!rse) return fail_arg(err, "environment: no data");
+    int slot = 0;
+    while (slot < f->env_count && strcmp(f->envs[slot].name, name)) slot++;
+    if (slot == ROUGE_MAX_ENVIRONMENTS)
+        return rs_fail(&e, RS_ERR_LIMIT, "environment '%s': the face has %d already", name, ROUGE_MAX_ENVIRONMENTS),
+               fail_out(err, &e);
+    rs_env *env = NULL;
+    rs_result r = rs_env_load_memory(rse, size, &env, &e);
+    if (r) {
+        rs_error inner = e;
+        rs_fail(&e, inner.code, "environment '%s': %s", name, inner.msg);
+        return fail_out(err, &e);
+    }
+    if (!strcmp(f->env_name, name)) {
+        // The view lights with this name now: relight it with the new one.
+        gl_saved s;
+        if (!(r = gl_save(f, &s, &e))) {
+            r = rs_render_set_env(f->ren, env, &e);
+            gl_restore(&s);
+        }
+        if (r) {
+            if (!rs_render_has_env(f->ren)) f->env_name[0] = 0;
+            rs_env_destroy(env);
+            return fail_out(err, &e);
+        }
+        f->changed = true;
+    }
+    if (slot == f->env_count) f->env_count++;
+    rs_env_destroy(f->envs[slot].env);
+    snprintf(f->envs[slot].name, sizeof f->envs[slot].name, "%s", name);
+    f->envs[slot].env = env;
+    return ROUGE_OK;
 }
 
 rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_error *err)
@@ -605,11 +705,12 @@ rouge_result rouge_face_set_view(rouge_face *f, const rouge_view *view, rouge_er
         // A new environment: load and upload it now, so a bad name or file fails here and the old
         // view stays.
         rs_env *e_cpu = NULL;
+        const rs_env *own = face_env(f, env);
         rs_error e = {0};
-        rs_result r = rs_env_open(env, f->env_dir, &e_cpu, &e);
+        rs_result r = own ? RS_OK : rs_env_open(env, f->env_dir, &e_cpu, &e);
         gl_saved s;
         if (r == RS_OK && (r = gl_save(f, &s, &e)) == RS_OK) {
-            r = rs_render_set_env(f->ren, e_cpu, &e);
+            r = rs_render_set_env(f->ren, own ? own : e_cpu, &e);
             gl_restore(&s);
         }
         rs_env_destroy(e_cpu);
@@ -729,18 +830,25 @@ void rouge_face_orbit(rouge_face *f, float yaw_deg, float pitch_deg)
     camera_changed(f);
 }
 
-void rouge_face_pan(rouge_face *f, float dx_px, float dy_px)
+// Pans by pixels of the last frame.
+static void pan_px(rouge_face *f, float dx_px, float dy_px)
 {
-    if (!f || !isfinite(dx_px) || !isfinite(dy_px)) return;
     const rs_view *fv = pointer_view(f);
     f->view.pan[0] += dx_px / (float)fv->height;
     f->view.pan[1] += dy_px / (float)fv->height;
     camera_changed(f);
 }
 
-void rouge_face_zoom_at(rouge_face *f, float factor, float x_px, float y_px)
+void rouge_face_pan(rouge_face *f, float dx, float dy)
 {
-    if (!f || !isfinite(factor) || !isfinite(x_px) || !isfinite(y_px)) return;
+    if (!f || !isfinite(dx) || !isfinite(dy)) return;
+    pointer_view(f);
+    pan_px(f, dx * f->frame_ratio, dy * f->frame_ratio);
+}
+
+// Zooms about (x, y), pixels of the last frame.
+static void zoom_at_px(rouge_face *f, float factor, float x_px, float y_px)
+{
     const rs_view *fv = pointer_view(f);
     float z0 = f->view.zoom > 0 ? f->view.zoom : 1.0f, z1 = RS_CLAMP(z0 * factor, ZOOM_MIN, ZOOM_MAX);
     if (!(factor > 0) || z1 == z0) return;
@@ -751,6 +859,21 @@ void rouge_face_zoom_at(rouge_face *f, float factor, float x_px, float y_px)
     f->view.pan[1] = oy - (oy - f->view.pan[1]) * s;
     f->view.zoom = z1;
     camera_changed(f);
+}
+
+void rouge_face_zoom_at(rouge_face *f, float factor, float x, float y)
+{
+    if (!f || !isfinite(factor) || !isfinite(x) || !isfinite(y)) return;
+    pointer_view(f);
+    zoom_at_px(f, factor, x * f->frame_ratio, y * f->frame_ratio);
+}
+
+rouge_result rouge_face_camera_matrices(rouge_face *f, float view_matrix[16], float proj_matrix[16],
+                                        rouge_error *err)
+{
+    if (!f || !view_matrix || !proj_matrix) return fail_arg(err, "camera: face and both matrices are required");
+    rs_render_view_matrices(f->ren, pointer_view(f), view_matrix, proj_matrix);
+    return ROUGE_OK;
 }
 
 // --- picking (the paint session's picker: the ID buffer of the last frame's view) -------------------------
@@ -780,12 +903,21 @@ static void dir_cb(void *user, const float pos[3], float dir[3])
 
 // --- lifecycle -------------------------------------------------------------------------------------------
 
+// The host's progress callback (rouge_face_desc.progress): RS_OK to go on, else the cancellation (a code
+// only the public API has) in e.
+static rs_result progress(const rouge_face_desc *d, float fraction, rs_error *e)
+{
+    if (!d->progress || d->progress(d->progress_user, fraction)) return RS_OK;
+    return rs_fail(e, (rs_result)ROUGE_ERR_CANCELLED, "cancelled");
+}
+
 rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, rouge_error *err)
 {
     rs_error e = {0};
     if (!desc || !out) return fail_arg(err, "rouge_face_create: desc and out are required");
     if (!desc->path && !desc->data && !desc->stream)
         return fail_arg(err, "rouge_face_create: desc needs a path, data or a stream");
+    if (progress(desc, 0.0f, &e)) return fail_out(err, &e);
     rs_gl_caps caps = {0};
     if (rs_gl_query_caps(&caps, &e) != RS_OK) return fail_out(err, &e);
     rouge_face *f = calloc(1, sizeof *f);
@@ -806,6 +938,8 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
     rs_result r = desc->path     ? rs_splat_load(desc->path, &f->cloud, &e)
                   : desc->stream ? stream_cloud(desc->stream, &f->cloud, &e)
                                  : rs_splat_load_memory(desc->data, desc->size, &f->cloud, &e);
+    // Parsing and decoding take about half of create, the upload and shaders most of the rest.
+    if (!r) r = progress(desc, 0.5f, &e);
     gl_saved s;
     if (!r && !(r = gl_save(f, &s, &e))) {
         r = rs_render_create(&(rs_render_desc){.cloud = f->cloud, .caps = &caps,
@@ -813,6 +947,7 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
                              &f->ren, &e);
         gl_restore(&s);
     }
+    if (!r) r = progress(desc, 0.85f, &e);
     if (!r) r = rs_makeup_create(f->cloud, &(rs_makeup_desc){.undo_levels = desc->undo_levels}, &f->mk, &e);
     rs_paint_picker pk = {.user = f, .pick = pick_cb, .pixels_per_unit = ppu_cb, .view_dir = dir_cb};
     if (!r) r = rs_paint_create(f->mk, &pk, &(rs_paint_desc){.input.mode = RS_INPUT_PAINT}, &f->paint, &e);
@@ -821,8 +956,10 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
         rs_makeup_uniforms u;
         rs_makeup_get_uniforms(f->mk, &u);
         rs_render_set_makeup_uniforms(f->ren, &u);
+        r = progress(desc, 0.9f, &e);
     }
     rouge_result pr = r ? ROUGE_OK : rouge_face_set_view(f, desc->view, err);
+    if (!r && !pr) r = progress(desc, 1.0f, &e);
     if (r || pr) {
         rouge_face_destroy(f);
         return r ? fail_out(err, &e) : pr;
@@ -852,6 +989,7 @@ void rouge_face_destroy(rouge_face *f)
         rs_render_destroy(f->ren);
         gl_restore(&s);
     }
+    for (int i = 0; i < f->env_count; i++) rs_env_destroy(f->envs[i].env);
     rs_splat_destroy(f->cloud);
     free(f);
 }
@@ -925,6 +1063,7 @@ static rs_result render_at(rouge_face *f, int w, int h, rs_error *e)
     }
     if (r) return r;
     f->frame_view = v;
+    f->frame_ratio = ratio_of(&f->view);
     f->have_frame = true;
     f->changed = false;
     return RS_OK;
@@ -1150,16 +1289,19 @@ rouge_result rouge_face_pointer(rouge_face *f, const rouge_pointer_event *ev, ro
         rs_strokes_view sv = strokes_view(fv);
         rs_paint_set_recorder(f->paint, f->rec, &sv);
     }
-    rs_input_event in = {(rs_input_type)ev->type, ev->id, ev->x, ev->y, ev->pressure > 0 ? ev->pressure : 1.0f,
-                         ev->time_s};
+    // Window units to the last frame's pixels; what comes back goes the other way.
+    float k = f->frame_ratio;
+    rs_input_event in = {(rs_input_type)ev->type, ev->id, ev->x * k, ev->y * k,
+                         ev->pressure > 0 ? ev->pressure : 1.0f, ev->time_s};
     rs_paint_result res;
     rs_result r = rs_paint_feed(f->paint, &in, &res, &e);
     if (res.stamps || res.stroke_cancel || res.stroke_end) f->changed = true;
-    if (!f->manual_navigation) {
+    if (!f->manual_navigation && !f->view.use_matrices) {
+        // Degrees per window unit: a drag turns the face alike at every pixel ratio.
         if (res.orbit_dx_px != 0 || res.orbit_dy_px != 0)
-            rouge_face_orbit(f, -res.orbit_dx_px * ORBIT_DEG_PER_PX, res.orbit_dy_px * ORBIT_DEG_PER_PX);
-        if (res.pan_dx_px != 0 || res.pan_dy_px != 0) rouge_face_pan(f, res.pan_dx_px, res.pan_dy_px);
-        if (res.zoom > 0 && res.zoom != 1.0f) rouge_face_zoom_at(f, res.zoom, res.zoom_cx_px, res.zoom_cy_px);
+            rouge_face_orbit(f, -res.orbit_dx_px / k * ORBIT_DEG_PER_PX, res.orbit_dy_px / k * ORBIT_DEG_PER_PX);
+        if (res.pan_dx_px != 0 || res.pan_dy_px != 0) pan_px(f, res.pan_dx_px, res.pan_dy_px);
+        if (res.zoom > 0 && res.zoom != 1.0f) zoom_at_px(f, res.zoom, res.zoom_cx_px, res.zoom_cy_px);
     }
     if (!r && res.stroke_end && f->rec) {
         char *text = NULL;
@@ -1171,9 +1313,9 @@ rouge_result rouge_face_pointer(rouge_face *f, const rouge_pointer_event *ev, ro
     if (out)
         *out = (rouge_pointer_result){.stamps = res.stamps, .misses = res.misses, .stroke_begin = res.stroke_begin,
                                       .stroke_end = res.stroke_end, .stroke_cancel = res.stroke_cancel,
-                                      .orbit_dx = res.orbit_dx_px, .orbit_dy = res.orbit_dy_px,
-                                      .pan_dx = res.pan_dx_px, .pan_dy = res.pan_dy_px, .zoom = res.zoom,
-                                      .zoom_x = res.zoom_cx_px, .zoom_y = res.zoom_cy_px};
+                                      .orbit_dx = res.orbit_dx_px / k, .orbit_dy = res.orbit_dy_px / k,
+                                      .pan_dx = res.pan_dx_px / k, .pan_dy = res.pan_dy_px / k, .zoom = res.zoom,
+                                      .zoom_x = res.zoom_cx_px / k, .zoom_y = res.zoom_cy_px / k};
     (void)fv;
     return r ? fail_out(err, &e) : ROUGE_OK;
 }
@@ -1345,16 +1487,54 @@ rouge_result rouge_face_play_strokes(rouge_face *f, const char *path, rouge_erro
 
 // --- queries ---------------------------------------------------------------------------------------------
 
+rouge_result rouge_face_look_info(const rouge_face *f, rouge_look_item *items, int capacity, int *count,
+                                  rouge_error *err)
+{
+    if (!f || !count || capacity < 0 || (capacity > 0 && !items))
+        return fail_arg(err, "look info: face and count are required, items for a capacity over 0");
+    // Stamps per product of the log (the layer as it is now); the log's product table is in order of
+    // first use.
+    uint32_t ncos = rs_makeup_log_cosmetic_count(f->mk), nst = rs_makeup_log_count(f->mk);
+    uint32_t *stamps = calloc(ncos ? ncos : 1, sizeof *stamps);
+    if (!stamps) {
+        rs_error e = {0};
+        return rs_fail(&e, RS_ERR_NOMEM, "look info: out of memory"), fail_out(err, &e);
+    }
+    const rs_makeup_applied *log = rs_makeup_log_stamps(f->mk);
+    for (uint32_t i = 0; i < nst; i++)
+        if (!log[i].eraser && log[i].cosmetic < ncos) stamps[log[i].cosmetic]++;
+    int n = 0;
+    for (uint32_t c = 0; c < ncos; c++) {
+        if (!stamps[c]) continue;
+        if (n < capacity) {
+            const rs_cosmetic *cos = rs_makeup_log_cosmetic(f->mk, c);
+            rouge_look_item *it = &items[n];
+            *it = (rouge_look_item){.kind = rs_cosmetic_kind_name(cos->kind),
+                                    .finish = (rouge_finish)(rs_cosmetic_finish(cos) + 1),
+                                    .coverage = cos->coverage, .stamps = stamps[c]};
+            snprintf(it->name, sizeof it->name, "%s", cos->name);
+            memcpy(it->rgb, cos->rgb, 3);
+        }
+        n++;
+    }
+    free(stamps);
+    *count = n;
+    return ROUGE_OK;
+}
+
 bool rouge_face_pick(rouge_face *f, float x, float y, rouge_pick *out)
 {
     uint32_t idx;
     float hit[3];
-    if (!f || !isfinite(x) || !isfinite(y) || !pick_cb(f, x, y, &idx, hit)) return false;
+    if (!f || !isfinite(x) || !isfinite(y)) return false;
+    pointer_view(f);
+    float k = f->frame_ratio;
+    if (!pick_cb(f, x * k, y * k, &idx, hit)) return false;
     if (out) {
         float ppu = rs_render_pixels_per_unit(f->ren, pointer_view(f), hit);
         *out = (rouge_pick){.splat = idx, .position = {hit[0], hit[1], hit[2]},
                             .region = (int)(f->cloud->packed[idx].w[1] >> 24),
-                            .brush_radius_px = rs_paint_radius(f->paint) * ppu};
+                            .brush_radius_px = rs_paint_radius(f->paint) * ppu / k};
     }
     return true;
 }

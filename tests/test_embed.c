@@ -443,6 +443,263 @@ static void test_version_matches_the_header(void)
              rouge_version_number());
 }
 
+// A blush stroke along the cheek, its coordinates scaled by k; the stamps it applied.
+static uint32_t cheek_stroke(rouge_face *f, float k)
+{
+    rouge_error e = {0};
+    uint32_t stamps = 0;
+    for (int i = 0; i <= 8; i++) {
+        rouge_pointer_event ev = {i == 0 ? ROUGE_POINTER_DOWN : i == 8 ? ROUGE_POINTER_UP : ROUGE_POINTER_MOVE, 1,
+                                  SIZE * (0.35f + 0.03f * (float)i) * k, SIZE * 0.6f * k, 1, 0.02 * i};
+        rouge_pointer_result res = {0};
+        RS_CHECK(rouge_face_pointer(f, &ev, &res, &e) == ROUGE_OK, "%s", e.msg);
+        stamps += res.stamps;
+    }
+    return stamps;
+}
+
+// The look after one cheek stroke at view.pixel_ratio `ratio` with coordinates scaled by k (then cleared).
+static char *look_of_stroke(float ratio, float k, size_t *len, uint32_t *stamps)
+{
+    rouge_error e = {0};
+    rouge_view v = small_view();
+    v.pixel_ratio = ratio;
+    char *look = NULL;
+    if (RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK && rouge_face_render(face, &e) == ROUGE_OK &&
+                     rouge_face_clear(face, &e) == ROUGE_OK &&
+                     rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .size = 0.15f, .opacity = 1}, &e) ==
+                         ROUGE_OK,
+                 "%s", e.msg)) {
+        *stamps = cheek_stroke(face, k);
+        RS_CHECK(rouge_face_save_look_memory(face, &look, len, &e) == ROUGE_OK, "%s", e.msg);
+    }
+    rouge_face_clear(face, NULL);
+    return look;
+}
+
+// pixel_ratio: a host passes window units (frame pixels / ratio). The stroke at ratio 2 with its coordinates
+// halved paints the stamps the stroke in pixels paints at ratio 1 (and not those of halved pixels); picks
+// and pan take window units too.
+static void test_pixel_ratio_takes_window_units(void)
+{
+    size_t la = 0, lb = 0, lc = 0;
+    uint32_t sa = 0, sb = 0, sc = 0;
+    char *a = look_of_stroke(1, 1, &la, &sa), *b = look_of_stroke(2, 0.5f, &lb, &sb), *c = look_of_stroke(1, 0.5f, &lc, &sc);
+    RS_CHECK(a && b && c && sa > 0, "looks %p %p %p, %u stamps", (void *)a, (void *)b, (void *)c, sa);
+    if (a && b && c) {
+        RS_CHECK(sa == sb && la == lb && !memcmp(a, b, la), "ratio 2 with halved coordinates: %u stamps vs %u, look differs",
+                 sb, sa);
+        RS_CHECK(lc != la || memcmp(a, c, la), "halved pixels at ratio 1 paint elsewhere (the check means something)");
+    }
+    rouge_free(a), rouge_free(b), rouge_free(c);
+    rouge_error e = {0};
+    rouge_view v = small_view();
+    rouge_pick p1 = {0}, p2 = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK && rouge_face_render(face, &e) == ROUGE_OK, "%s", e.msg);
+    bool h1 = rouge_face_pick(face, SIZE * 0.45f, SIZE * 0.55f, &p1);
+    v.pixel_ratio = 2;
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK && rouge_face_render(face, &e) == ROUGE_OK, "%s", e.msg);
+    bool h2 = rouge_face_pick(face, SIZE * 0.225f, SIZE * 0.275f, &p2);
+    RS_CHECK(h1 && h2 && p1.splat == p2.splat && fabsf(p2.brush_radius_px * 2 - p1.brush_radius_px) < 1e-3f,
+             "pick %d %u r %g vs %d %u r %g", h1, p1.splat, p1.brush_radius_px, h2, p2.splat, p2.brush_radius_px);
+    rouge_face_pan(face, 8, 0);
+    RS_CHECK(fabsf(rouge_face_get_view(face).pan[0] - 16.0f / SIZE) < 1e-6f, "pan 8 window units = 16 pixels: %g",
+             rouge_face_get_view(face).pan[0]);
+    v.pixel_ratio = -1;
+    RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_ERR_ARG && strstr(e.msg, "pixel_ratio"), "%s", e.msg);
+    v = small_view();
+    RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+}
+
+// The host's camera: the matrices rouge built for a turned view, handed back with use_matrices on an
+// unturned orbit view, give that turned view's picture and picks; the orbit view alone does not.
+static void test_host_matrices_replace_the_orbit_camera(void)
+{
+    size_t n = (size_t)SIZE * SIZE * 4;
+    uint8_t *a = malloc(n), *b = malloc(n), *c = malloc(n);
+    RS_REQUIRE(a && b && c, "alloc");
+    rouge_error e = {0};
+    rouge_view v = small_view();
+    v.yaw_deg = 30, v.pitch_deg = 10, v.zoom = 1.4f, v.pan[0] = 0.05f;
+    float vm[16], pm[16];
+    rouge_pick pa = {0}, pb = {0};
+    if (!RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK && frame(face, a), "%s", e.msg)) goto out;
+    bool ha = rouge_face_pick(face, SIZE * 0.5f, SIZE * 0.5f, &pa);
+    RS_REQUIRE(rouge_face_camera_matrices(face, vm, pm, &e) == ROUGE_OK, "%s", e.msg);
+    rouge_view w = small_view();
+    w.use_matrices = true;
+    memcpy(w.view_matrix, vm, sizeof vm), memcpy(w.proj_matrix, pm, sizeof pm);
+    if (!RS_CHECK(rouge_face_set_view(face, &w, &e) == ROUGE_OK && frame(face, b), "%s", e.msg)) goto out;
+    bool hb = rouge_face_pick(face, SIZE * 0.5f, SIZE * 0.5f, &pb);
+    RS_CHECK(max_diff(a, b, n) <= 1, "host matrices differ from the camera they came from by %d", max_diff(a, b, n));
+    RS_CHECK(ha && hb && pa.splat == pb.splat, "pick %d %u vs %d %u", ha, pa.splat, hb, pb.splat);
+    // Gestures only report: a one-finger orbit leaves the picture alone.
+    rouge_face_set_painting(face, false);
+    rouge_pointer_result res = {0};
+    for (int i = 0; i < 3; i++) {
+        rouge_pointer_event ev = {i == 0 ? ROUGE_POINTER_DOWN : i == 2 ? ROUGE_POINTER_UP : ROUGE_POINTER_MOVE, 1,
+                                  10.0f + 10.0f * (float)i, 30, 1, 0.05 * i};
+        RS_CHECK(rouge_face_pointer(face, &ev, i == 1 ? &res : NULL, &e) == ROUGE_OK, "%s", e.msg);
+    }
+    rouge_face_set_painting(face, true);
+    RS_CHECK(frame(face, c) && max_diff(b, c, n) == 0 && res.orbit_dx != 0, "an orbit gesture moved the host's camera");
+    if (!RS_CHECK(rouge_face_set_view(face, &(rouge_view){.width = SIZE, .height = SIZE, .max_splats = MAX_SPLATS}, &e) ==
+                      ROUGE_OK && frame(face, c), "%s", e.msg))
+        goto out;
+    RS_CHECK(max_diff(b, c, n) > 32, "the orbit view looks like the turned one (max diff %d)", max_diff(b, c, n));
+    // Refused at set_view, naming the field: NaN, a scaled view, an orthographic projection.
+    rouge_view bad = w;
+    bad.proj_matrix[5] = NAN;
+    RS_CHECK(rouge_face_set_view(face, &bad, &e) == ROUGE_ERR_ARG && strstr(e.msg, "proj_matrix[5]"), "%s", e.msg);
+    bad = w;
+    for (int i = 0; i < 3; i++) bad.view_matrix[i] *= 2;
+    RS_CHECK(rouge_face_set_view(face, &bad, &e) == ROUGE_ERR_ARG && strstr(e.msg, "rigid"), "%s", e.msg);
+    bad = w;
+    bad.proj_matrix[11] = 0, bad.proj_matrix[15] = 1;
+    RS_CHECK(rouge_face_set_view(face, &bad, &e) == ROUGE_ERR_ARG && strstr(e.msg, "perspective"), "%s", e.msg);
+    RS_CHECK(rouge_face_camera_matrices(face, vm, NULL, &e) == ROUGE_ERR_ARG, "NULL matrix");
+out:
+    rouge_face_set_view(face, &(rouge_view){.width = SIZE, .height = SIZE, .max_splats = MAX_SPLATS}, NULL);
+    free(a), free(b), free(c);
+}
+
+// After a blush stroke and a custom red lipstick stroke the look lists both, in that order, with their
+// colours, finishes and stamps (all the look's); asking for the count only works; undo drops the second.
+static void test_look_info_lists_the_products(void)
+{
+    rouge_error e = {0};
+    rouge_cosmetic blush = {0}, lip = {0};
+    for (int i = 0; i < rouge_cosmetic_count(); i++) {
+        rouge_cosmetic c;
+        rouge_cosmetic_get(i, &c);
+        if (!strcmp(c.name, "blush")) blush = c;
+        if (!strcmp(c.name, "lipstick_satin")) lip = c;
+    }
+    RS_REQUIRE(blush.name && lip.name, "presets");
+    RS_REQUIRE(rouge_face_set_view(face, &(rouge_view){.width = SIZE, .height = SIZE, .max_splats = MAX_SPLATS}, &e) ==
+                       ROUGE_OK && rouge_face_render(face, &e) == ROUGE_OK && rouge_face_clear(face, &e) == ROUGE_OK,
+               "%s", e.msg);
+    int n = -1;
+    RS_CHECK(rouge_face_look_info(face, NULL, 0, &n, &e) == ROUGE_OK && n == 0, "bare face: %d products", n);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .size = 0.15f, .opacity = 1}, &e) == ROUGE_OK,
+               "%s", e.msg);
+    uint32_t s1 = cheek_stroke(face, 1);
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "lipstick_satin", .color = {1, 0, 0, 1},
+                                                         .size = 0.1f, .opacity = 1, .any_region = true},
+                                    &e) == ROUGE_OK,
+               "%s", e.msg);
+    uint32_t s2 = cheek_stroke(face, 1);
+    rouge_look_item items[4];
+    memset(items, 0xab, sizeof items);
+    RS_CHECK(rouge_face_look_info(face, NULL, 0, &n, &e) == ROUGE_OK && n == 2, "count only: %d", n);
+    n = -1;
+    RS_REQUIRE(rouge_face_look_info(face, items, 4, &n, &e) == ROUGE_OK && n == 2, "%d products: %s", n, e.msg);
+    rouge_look_item *b = &items[0], *l = &items[1];
+    RS_CHECK(!strcmp(b->name, "blush") && !strcmp(b->kind, blush.kind) && !memcmp(b->rgb, blush.rgb, 3) &&
+                 b->finish == blush.finish && b->coverage == blush.coverage && b->stamps == s1 && s1 > 0,
+             "blush: %s %s rgb %u %u %u finish %d stamps %u (painted %u)", b->name, b->kind, b->rgb[0], b->rgb[1],
+             b->rgb[2], b->finish, b->stamps, s1);
+    RS_CHECK(!strcmp(l->name, "custom_lipstick_satin") && !strcmp(l->kind, lip.kind) && l->rgb[0] == 255 &&
+                 l->rgb[1] == 0 && l->rgb[2] == 0 && l->stamps == s2 && s2 > 0,
+             "lipstick: %s %s rgb %u %u %u stamps %u (painted %u)", l->name, l->kind, l->rgb[0], l->rgb[1], l->rgb[2],
+             l->stamps, s2);
+    RS_CHECK(b->stamps + l->stamps == rouge_face_stats(face).look_stamps, "stamps %u + %u of %u", b->stamps, l->stamps,
+             rouge_face_stats(face).look_stamps);
+    n = -1;
+    RS_CHECK(rouge_face_look_info(face, items, 1, &n, &e) == ROUGE_OK && n == 2 && !strcmp(items[0].name, "blush"),
+             "capacity 1: %d", n);
+    RS_CHECK(rouge_face_undo(face) && rouge_face_look_info(face, items, 4, &n, &e) == ROUGE_OK && n == 1,
+             "after undo: %d products", n);
+    RS_CHECK(rouge_face_look_info(face, NULL, 2, &n, &e) == ROUGE_ERR_ARG && rouge_face_look_info(NULL, items, 4, &n, &e) ==
+                 ROUGE_ERR_ARG, "NULL items or face");
+    rouge_face_clear(face, NULL);
+}
+
+typedef struct progress_log {
+    float last;
+    int calls;
+    bool monotonic;
+    float cancel_at;  // returns false from this fraction on (negative: never)
+} progress_log;
+
+static bool on_progress(void *user, float fraction)
+{
+    progress_log *p = user;
+    if (!(fraction >= p->last && fraction >= 0 && fraction <= 1)) p->monotonic = false;
+    p->last = fraction;
+    p->calls++;
+    return !(p->cancel_at >= 0 && fraction >= p->cancel_at);
+}
+
+// create reports 0 .. 1, never decreasing; a false return at any stage cancels: ROUGE_ERR_CANCELLED,
+// "cancelled", *out untouched, nothing leaked (asan) and no GL error left.
+static void test_create_reports_progress_and_cancels(void)
+{
+    rouge_view v = small_view();
+    rouge_error e = {0};
+    progress_log p = {-1, 0, true, -1};
+    rouge_face *g = NULL;
+    RS_CHECK(rouge_face_create(&(rouge_face_desc){.path = FACE, .view = &v, .progress = on_progress, .progress_user = &p},
+                               &g, &e) == ROUGE_OK,
+             "%s", e.msg);
+    RS_CHECK(p.monotonic && p.last == 1 && p.calls >= 4, "progress: %d calls, last %g, monotonic %d", p.calls, p.last,
+             p.monotonic);
+    rouge_face_destroy(g);
+    const float stops[] = {0, 0.5f, 0.85f, 0.9f, 1};
+    for (size_t i = 0; i < RS_COUNT_OF(stops); i++) {
+        p = (progress_log){-1, 0, true, stops[i]};
+        rouge_face *sentinel = (rouge_face *)&p;
+        g = sentinel;
+        e = (rouge_error){0};
+        rouge_result r = rouge_face_create(
+            &(rouge_face_desc){.path = FACE, .view = &v, .progress = on_progress, .progress_user = &p}, &g, &e);
+        RS_CHECK(r == ROUGE_ERR_CANCELLED && e.code == ROUGE_ERR_CANCELLED && !strcmp(e.msg, "cancelled") && g == sentinel,
+                 "cancel at %g: %s '%s'", stops[i], rouge_result_name(r), e.msg);
+        RS_CHECK(p.last == stops[i], "cancelled at %g, last call %g", stops[i], p.last);
+        RS_CHECK(glGetError() == GL_NO_ERROR, "GL error after a cancel");
+    }
+    RS_CHECK(!strcmp(rouge_result_name(ROUGE_ERR_CANCELLED), "ROUGE_ERR_CANCELLED"), "name");
+}
+
+// A host without files hands an environment's bytes: under a new name it lights the face as the file
+// of the same bytes does; adding another under that name while in use relights at once; bad bytes and
+// "paper" are refused.
+static void test_environment_from_memory_renders_like_the_file(void)
+{
+    size_t n = (size_t)SIZE * SIZE * 4, dlen = 0, slen = 0;
+    uint8_t *a = malloc(n), *b = malloc(n);
+    void *day = NULL, *studio = NULL;
+    rouge_error e = {0};
+    rouge_view v = small_view();
+    RS_REQUIRE(a && b, "alloc");
+    if (!RS_CHECK(file_bytes("assets/env/daylight.rse", &day, &dlen) && file_bytes("assets/env/studio.rse", &studio, &slen),
+                  "read the environments"))
+        goto out;
+    v.env = "from_memory";
+    RS_CHECK(rouge_face_set_view(face, &v, &e) != ROUGE_OK, "an unknown name before it is added");
+    v.env = "daylight";
+    if (!RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK && frame(face, a), "%s", e.msg)) goto out;
+    RS_CHECK(rouge_face_add_environment(face, "from_memory", day, dlen, &e) == ROUGE_OK, "add: %s", e.msg);
+    v.env = "from_memory";
+    if (!RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK && frame(face, b), "%s", e.msg)) goto out;
+    RS_CHECK(max_diff(a, b, n) == 0, "daylight from memory differs from the file by %d", max_diff(a, b, n));
+    // Replaced while the view uses it: the next frame is lit by the new one.
+    RS_CHECK(rouge_face_add_environment(face, "from_memory", studio, slen, &e) == ROUGE_OK, "replace: %s", e.msg);
+    RS_CHECK(frame(face, b), "frame");
+    v.env = "studio";
+    if (!RS_CHECK(rouge_face_set_view(face, &v, &e) == ROUGE_OK && frame(face, a), "%s", e.msg)) goto out;
+    RS_CHECK(max_diff(a, b, n) == 0, "replaced environment: differs from studio by %d", max_diff(a, b, n));
+    e = (rouge_error){0};
+    RS_CHECK(rouge_face_add_environment(face, "junk", "not an environment", 18, &e) == ROUGE_ERR_FORMAT &&
+                 strstr(e.msg, "junk"),
+             "bad bytes: %s %s", rouge_result_name(e.code), e.msg);
+    RS_CHECK(rouge_face_add_environment(face, "paper", day, dlen, &e) == ROUGE_ERR_ARG, "paper: %s", e.msg);
+    RS_CHECK(rouge_face_add_environment(face, "x", NULL, 10, &e) == ROUGE_ERR_ARG, "NULL bytes");
+out:
+    rouge_face_set_view(face, &(rouge_view){.width = SIZE, .height = SIZE, .max_splats = MAX_SPLATS}, NULL);
+    free(a), free(b), free(day), free(studio);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -468,6 +725,11 @@ int main(int argc, char **argv)
     RS_RUN(test_environments_found_from_any_working_directory);
     RS_RUN(test_load_look_clears_undo);
     RS_RUN(test_version_matches_the_header);
+    RS_RUN(test_pixel_ratio_takes_window_units);
+    RS_RUN(test_host_matrices_replace_the_orbit_camera);
+    RS_RUN(test_look_info_lists_the_products);
+    RS_RUN(test_create_reports_progress_and_cancels);
+    RS_RUN(test_environment_from_memory_renders_like_the_file);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
     return rs_test_finish();

@@ -42,7 +42,7 @@ const FINISHES = ['default', 'matte', 'satin', 'gloss', 'shimmer'];
 const PRESSURES = ['floor', 'linear', 'none'];
 const POINTER = { down: 0, move: 1, up: 2, cancel: 3 };
 const RESULT_NAMES = ['ROUGE_OK', 'ROUGE_ERR_IO', 'ROUGE_ERR_FORMAT', 'ROUGE_ERR_LIMIT', 'ROUGE_ERR_NOMEM',
-                      'ROUGE_ERR_GL', 'ROUGE_ERR_ARG'];
+                      'ROUGE_ERR_GL', 'ROUGE_ERR_ARG', 'ROUGE_ERR_CANCELLED'];
 const ENV_DIR = '/env';
 // A preview face costs a face creation (shaders, targets): only when the face is slow to arrive, and not
 // more often than this.

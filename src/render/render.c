@@ -56,8 +56,31 @@ static void frame_dir(const rs_splat_header *h, float yaw_deg, float pitch_deg, 
         out[a] = cosf(p) * (cosf(y) * f[a] + sinf(y) * right[a]) + sinf(p) * u[a];
 }
 
+// The host's camera (rs_view.use_matrices): near and far come from the perspective projection
+// (P[2][2] = -(f+n)/(f-n), P[3][2] = -2fn/(f-n)), the pixel size from its focal length.
+static void host_camera(const rs_renderer *r, const rs_view *v, rs_camera *cam)
+{
+    memcpy(cam->view, v->view_matrix, sizeof cam->view);
+    memcpy(cam->proj, v->proj_matrix, sizeof cam->proj);
+    glm_mat4_inv(cam->view, cam->inv_view);
+    glm_mat4_inv(cam->proj, cam->inv_proj);
+    for (int a = 0; a < 3; a++) cam->eye[a] = cam->inv_view[3][a];
+    cam->near_z = cam->proj[3][2] / (cam->proj[2][2] - 1.0f);
+    cam->far_z = cam->proj[3][2] / (cam->proj[2][2] + 1.0f);
+    cam->width = v->width;
+    cam->height = v->height;
+    cam->px_size = 2.0f / (cam->proj[1][1] * (float)v->height);
+    vec3 bc = {r->bound_centre[0], r->bound_centre[1], r->bound_centre[2]};
+    float bd = glm_vec3_distance(cam->eye, bc);
+    cam->ppu_max = 1.0f / (cam->px_size * fmaxf(bd - r->bound_radius, cam->near_z));
+}
+
 void rs_render_camera(const rs_renderer *r, const rs_view *v, rs_camera *cam)
 {
+    if (v->use_matrices) {
+        host_camera(r, v, cam);
+        return;
+    }
     const rs_splat_header *h = &r->cloud->hdr;
     float pitch = RS_CLAMP(v->pitch_deg, -89.0f, 89.0f);
     vec3 d, up;
@@ -624,7 +647,9 @@ static bool same_view(const rs_view *a, const rs_view *b)
            a->max_splats == b->max_splats && a->kernel_count == b->kernel_count && a->lod_density == b->lod_density &&
            a->prim == b->prim && a->ambient == b->ambient && a->lighting == b->lighting &&
            a->env_rotate_deg == b->env_rotate_deg && a->env_intensity == b->env_intensity && a->tonemap == b->tonemap &&
-           a->linear_output == b->linear_output;
+           a->linear_output == b->linear_output && a->use_matrices == b->use_matrices &&
+           (!a->use_matrices || (!memcmp(a->view_matrix, b->view_matrix, sizeof a->view_matrix) &&
+                                 !memcmp(a->proj_matrix, b->proj_matrix, sizeof a->proj_matrix)));
 }
 
 void rs_render_invalidate(rs_renderer *r) { r->inc_valid = false; }
@@ -864,6 +889,15 @@ void rs_render_view_dir(const rs_renderer *r, const rs_view *view, const float p
     vec3 d = {cam.eye[0] - pos[0], cam.eye[1] - pos[1], cam.eye[2] - pos[2]};
     glm_vec3_normalize(d);
     dir[0] = d[0], dir[1] = d[1], dir[2] = d[2];
+}
+
+void rs_render_view_matrices(const rs_renderer *r, const rs_view *view, float view_m[16], float proj_m[16])
+{
+    rs_view v = view_resolved(view);
+    rs_camera cam;
+    rs_render_camera(r, &v, &cam);
+    memcpy(view_m, cam.view, sizeof cam.view);
+    memcpy(proj_m, cam.proj, sizeof cam.proj);
 }
 
 bool rs_render_project(const rs_renderer *r, const rs_view *view, const float pos[3], float px[2])

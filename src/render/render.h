@@ -106,6 +106,10 @@ typedef struct rs_view {
     float env_intensity;        // multiplies the environment (after its normalisation); 0 means 1
     rs_tonemap tonemap;
     bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)
+    // A host's camera instead of the orbit one (yaw, pitch, zoom, fov, pan ignored): model -> eye (rigid)
+    // and a perspective eye -> clip, column-major (rouge.h rouge_view.use_matrices; checked by the caller).
+    bool use_matrices;
+    float view_matrix[16], proj_matrix[16];
 } rs_view;
 
 // Defaults: 512x512, frontal, zoom 1, fov 30, key light from upper left-front (yaw -35, pitch 30), fill
@@ -164,6 +168,8 @@ bool rs_render_pick(rs_renderer *r, const rs_view *view, float x_px, float y_px,
 float rs_render_pixels_per_unit(const rs_renderer *r, const rs_view *view, const float pos[3]);
 // Unit vector from a model-space point towards the camera.
 void rs_render_view_dir(const rs_renderer *r, const rs_view *view, const float pos[3], float dir[3]);
+// The camera's model -> eye and eye -> clip matrices for this view, column-major.
+void rs_render_view_matrices(const rs_renderer *r, const rs_view *view, float view_m[16], float proj_m[16]);
 // Projects a model-space point to pixels (top-left origin); false when behind the camera.
 bool rs_render_project(const rs_renderer *r, const rs_view *view, const float pos[3], float px[2]);
 

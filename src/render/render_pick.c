@@ -28,7 +28,10 @@ static bool same_geometry(const rs_view *a, const rs_view *b)
     return a->width == b->width && a->height == b->height && a->yaw_deg == b->yaw_deg &&
            a->pitch_deg == b->pitch_deg && a->zoom == b->zoom && a->fov_deg == b->fov_deg &&
            a->pan[0] == b->pan[0] && a->pan[1] == b->pan[1] && a->max_splats == b->max_splats &&
-           a->prim == b->prim && a->pipeline == b->pipeline && a->lod_density == b->lod_density;
+           a->prim == b->prim && a->pipeline == b->pipeline && a->lod_density == b->lod_density &&
+           a->use_matrices == b->use_matrices &&
+           (!a->use_matrices || (!memcmp(a->view_matrix, b->view_matrix, sizeof a->view_matrix) &&
+                                 !memcmp(a->proj_matrix, b->proj_matrix, sizeof a->proj_matrix)));
 }
 
 static bool ensure_pick_targets(rs_renderer *r, int w, int h)
