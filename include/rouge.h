@@ -399,10 +399,11 @@ typedef struct rouge_brush {
     float opacity;               // 0..1; 0 = the cosmetic's
     rouge_pressure pressure;
     bool eraser, mirror;         // mirror: also paint the mirror image across the face's mid-plane
-    // Region-aware by default: lipstick and gloss stay on the lips, liner and shadow on the eye area,
-    // base, powder, blush, bronzer and highlighter off the lips, eyes and brows, with a soft edge
-    // (~1.5 mm) at the region's border. true paints anywhere. Faces converted without eyelid/brow
-    // regions keep eye products unmasked.
+    // Region-aware by default: lipstick and gloss stay on the lips, shadow on the eye area, base,
+    // powder, blush, bronzer and highlighter off the lips, eyes and brows, with a soft edge (~1.5 mm) at
+    // the region's border. true paints anywhere. Faces converted without eyelid/brow regions keep eye
+    // products unmasked. A brush narrower than 4 mm (liner, brow pencil, mascara at their sizes) is
+    // drawn per pixel exactly where it is painted and is not masked: a pencil is its own mask.
     bool any_region;
 } rouge_brush;
 
