@@ -50,12 +50,14 @@ const vw_shortcut vw_shortcuts[] = {
     {"L+drag, sun dial", "move the light (environments: turn them)"},
     {"G, Shift+G, top chips", "next / previous lighting environment"},
     {"Arrows, +/-, 0", "orbit, zoom, reset camera and light"},
+    {"Shift+1, 2, 3", "zoom to the eyes, the lips, a cheek"},
     {"P", "paint / view mode"},
     {"1-9, Tab", "pick a cosmetic; Tab: next"},
     {"[ ], Shift+[ ]", "brush size, opacity"},
     {"E, M", "eraser, mirror painting"},
     {"K", "keep the brush to its region"},
     {"C", "product editor: colour, finish, coverage"},
+    {"V (in the editor)", "eyedropper: the face's colour under the pointer"},
     {"Ctrl+Z, Ctrl+Y", "undo, redo"},
     {"Delete", "clear all makeup"},
     {"A, D, F", "albedo / diffuse / full"},
@@ -535,10 +537,29 @@ static void toggle_split(vw_viewer *v)
     v->dirty_view = true;
 }
 
+// Shift+1-3: the eyes, the lips or a cheek fill the view (rouge_face_target on the face's regions); the
+// camera keeps its angle, so a three-quarter view zooms to the cheek that faces it.
+static void zoom_to_region(vw_viewer *v, int which)
+{
+    static const char *const regions[] = {"eyelid", "lips", "cheek"};
+    // Both eyes together are wide: they take more of the view than one lip or cheek would.
+    static const float fill[] = {0.7f, 0.0f, 0.0f};
+    rouge_error e = {0};
+    if (rouge_face_set_view(v->face, &v->view, &e) != ROUGE_OK ||
+        rouge_face_target(v->face, regions[which], fill[which], &e) != ROUGE_OK) {
+        vw_toast(v, true, "%s", e.msg);
+        return;
+    }
+    rouge_view t = rouge_face_get_view(v->face);
+    v->view.zoom = t.zoom;
+    v->view.pan[0] = t.pan[0], v->view.pan[1] = t.pan[1];
+    v->dirty_view = true;
+}
+
 static void key_action(vw_viewer *v, int key, int mods)
 {
     if (vw_looks_key(v, key, mods)) return;  // the look library's sheet or dialog has the keyboard
-    if (vw_editor_key(v, key, mods)) return;  // the product editor's keys (X, N, comma, period, Esc)
+    if (vw_editor_key(v, key, mods)) return;  // the product editor's keys (X, N, comma, period, V, Esc)
     bool ctrl = mods & GLFW_MOD_CONTROL, shift = mods & GLFW_MOD_SHIFT;
     int n = rouge_cosmetic_count();
     switch (key) {
@@ -602,7 +623,8 @@ static void key_action(vw_viewer *v, int key, int mods)
         break;
     case GLFW_KEY_G: next_env(v, shift ? -1 : 1); break;
     default:
-        if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && key - GLFW_KEY_1 < n) select_cosmetic(v, key - GLFW_KEY_1);
+        if (shift && key >= GLFW_KEY_1 && key <= GLFW_KEY_3) zoom_to_region(v, key - GLFW_KEY_1);
+        else if (key >= GLFW_KEY_1 && key <= GLFW_KEY_9 && key - GLFW_KEY_1 < n) select_cosmetic(v, key - GLFW_KEY_1);
         break;
     }
 }
@@ -938,10 +960,10 @@ static void write_state(vw_viewer *v, const char *path)
     const vw_editor *e = &v->editor;
     fprintf(f, "frame %lld\nscript_events %lld\nevents_applied %lld\nevents_dropped %d\n", v->frame_no,
             v->script.pushed, v->events_applied, v->queue.dropped);
-    fprintf(f, "yaw_deg %.4f\npitch_deg %.4f\nzoom %.4f\nlight_dial %.4f %.4f\n", v->view.yaw_deg, v->view.pitch_deg,
-            v->view.zoom, v->light_dial[0], v->light_dial[1]);
-    fprintf(f, "editor_open %d\neditor_hsv %.3f %.4f %.4f\neditor_rgb %d %d %d\n", e->open, e->hsv[0], e->hsv[1],
-            e->hsv[2], e->product.rgb[0], e->product.rgb[1], e->product.rgb[2]);
+    fprintf(f, "yaw_deg %.4f\npitch_deg %.4f\nzoom %.4f\npan %.4f %.4f\nlight_dial %.4f %.4f\n", v->view.yaw_deg,
+            v->view.pitch_deg, v->view.zoom, v->view.pan[0], v->view.pan[1], v->light_dial[0], v->light_dial[1]);
+    fprintf(f, "editor_open %d\neditor_hsv %.3f %.4f %.4f\neditor_rgb %d %d %d\nshades %d\n", e->open, e->hsv[0],
+            e->hsv[1], e->hsv[2], e->product.rgb[0], e->product.rgb[1], e->product.rgb[2], e->shade_count);
     fprintf(f, "render_scale %.3f\nrender_scale_range %.3f %.3f\n", v->render_scale, v->scale_lo, v->scale_hi);
     fprintf(f, "looks_sheet %d\nsave_dialog %d\nsave_name %s\nsplit %d\nsplit_left %s\ntoast %s\n", v->looks.open,
             v->looks.saving, v->looks.name, v->split, v->looks.compare[0] ? v->looks.compare : "(bare)", v->toast);
@@ -1182,6 +1204,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         v->last_input_s = -1e9;
         v->last_input_frame = -1000;
         vw_looks_init(v);
+        vw_editor_load_shades(v);
         dial_from_light(v);
         select_cosmetic(v, 0);
         v->paint_mode = false;

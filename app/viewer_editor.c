@@ -6,6 +6,7 @@
 
 #include <GLFW/glfw3.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,7 +16,7 @@ void vw_editor_layout_compute(const rs_ui_toolbar_layout *tb, float s, vw_editor
 {
     float pad = 12 * s, col = 150 * s, side = 84 * s;
     float w = 2 * pad + col + 12 * s + side;
-    float h = 44 * s + 100 * s + 8 * s + 16 * s + 12 * s + 28 * s + 12 * s + 16 * s + 30 * s + pad;
+    float h = 44 * s + 100 * s + 8 * s + 16 * s + 12 * s + 28 * s + 12 * s + 16 * s + 30 * s + 16 * s + 28 * s + pad;
     // Top right, under the environment chips and left of the right rail: the lips and the far cheek,
     // where most products go, stay clear in the default view.
     float x = tb->right.x - 12 * s - w, y = tb->top.y + tb->top.h + 54 * s;
@@ -29,6 +30,10 @@ void vw_editor_layout_compute(const rs_ui_toolbar_layout *tb, float s, vw_editor
     for (int i = 0; i < RS_FINISH_COUNT; i++)
         l.finish[i] = (rs_ui_rect){x + pad + (float)i * (fw + 4 * s), fy, fw, 28 * s};
     l.coverage = (rs_ui_rect){x + pad, fy + 28 * s + 12 * s + 16 * s, w - 2 * pad, 30 * s};
+    // My shades: a row of swatches under the coverage, "+" at its end keeps the product shown.
+    float sy = l.coverage.y + l.coverage.h + 16 * s, sw = (w - 2 * pad - VW_SHADES_MAX * 4 * s) / (VW_SHADES_MAX + 1);
+    for (int i = 0; i < VW_SHADES_MAX; i++) l.shades[i] = (rs_ui_rect){x + pad + (float)i * (sw + 4 * s), sy, sw, 28 * s};
+    l.shade_add = (rs_ui_rect){x + pad + VW_SHADES_MAX * (sw + 4 * s), sy, sw, 28 * s};
     *out = l;
 }
 
@@ -78,6 +83,66 @@ void vw_editor_toggle(vw_viewer *v)
     if (e->open) vw_editor_sync(v), v->paint_mode = true, vw_apply_brush(v);
 }
 
+static bool shades_path(const vw_viewer *v, char *path, size_t cap)
+{
+    return v->looks.dir[0] && snprintf(path, cap, "%s/%s", v->looks.dir, VW_SHADES_FILE) < (int)cap;
+}
+
+void vw_editor_load_shades(vw_viewer *v)
+{
+    vw_editor *e = &v->editor;
+    char path[1100], line[1024];
+    e->shade_count = 0;
+    FILE *f = shades_path(v, path, sizeof path) ? fopen(path, "r") : NULL;
+    if (!f) return;  // none kept yet
+    int n = 0;
+    while (e->shade_count < VW_SHADES_MAX && fgets(line, sizeof line, f)) {
+        line[strcspn(line, "\r\n")] = 0;
+        rs_error err = {0};
+        if (line[0] && rs_cosmetic_parse(line, &e->shades[e->shade_count], &err) == RS_OK) e->shade_count++;
+        else if (line[0]) n++;
+    }
+    fclose(f);
+    if (n) vw_toast(v, true, "%s: %d line%s not a product, skipped", path, n, n == 1 ? "" : "s");
+}
+
+// Keeps the product shown as the newest of my shades (the oldest goes when the row is full) and rewrites
+// the file (atomically: a crash leaves the old row).
+static void keep_shade(vw_viewer *v)
+{
+    vw_editor *e = &v->editor;
+    char path[1100];
+    if (!shades_path(v, path, sizeof path)) {
+        vw_toast(v, true, "My shades: no look library folder");
+        return;
+    }
+    if (e->shade_count == VW_SHADES_MAX) memmove(e->shades, e->shades + 1, sizeof e->shades[0] * (VW_SHADES_MAX - 1));
+    else e->shade_count++;
+    e->shades[e->shade_count - 1] = e->product;
+    char text[VW_SHADES_MAX * 512];
+    size_t len = 0;
+    for (int i = 0; i < e->shade_count; i++) {
+        int k = rs_cosmetic_format(&e->shades[i], text + len, sizeof text - len - 1);
+        if (k < 0 || (size_t)k >= sizeof text - len - 1) break;
+        len += (size_t)k;
+        text[len++] = '\n';
+    }
+    rs_error err = {0};
+    if (rs_looklib_make_dir(v->looks.dir, &err) != RS_OK || rs_file_write_atomic(path, text, len, &err) != RS_OK)
+        vw_toast(v, true, "My shades: %s", err.msg);
+    else vw_toast(v, false, "Kept in my shades (%s)", path);
+}
+
+// A tap on one of my shades: the brush paints it, the editor shows it.
+static void use_shade(vw_viewer *v, int i)
+{
+    vw_editor *e = &v->editor;
+    e->product = e->shades[i];
+    e->custom = true;
+    rs_cosmetic_rgb_to_hsv(e->product.rgb, &e->hsv[0], &e->hsv[1], &e->hsv[2]);
+    vw_apply_brush(v);
+}
+
 static bool parse_hex(const char *s, uint8_t rgb[3])
 {
     if (strlen(s) != 6) return false;
@@ -107,6 +172,38 @@ static void set_coverage(vw_viewer *v, float c)
     edited(v);
 }
 
+// The eyedropper (V): the colour of the face under the pointer, as the last frame shows it (3 x 3 pixels,
+// so a pore or a fleck does not decide it), becomes the product's.
+static void pick_colour(vw_viewer *v)
+{
+    int w = 0, h = 0;
+    rouge_pick p;
+    int cx = (int)(v->mx * v->render_scale), cy = (int)(v->my * v->render_scale);
+    if (!v->face || !rouge_face_texture(v->face, &w, &h) || !rouge_face_pick(v->face, cx + 0.5f, cy + 0.5f, &p)) {
+        vw_toast(v, true, "Eyedropper: no face under the pointer");
+        return;
+    }
+    size_t n = (size_t)w * (size_t)h * 4;
+    uint8_t *px = malloc(n);
+    rouge_error err = {0};
+    if (!px || rouge_face_read_rgba(v->face, px, n, &err) != ROUGE_OK) {
+        free(px);
+        vw_toast(v, true, "Eyedropper: %s", px ? err.msg : "out of memory");
+        return;
+    }
+    int sum[3] = {0}, k = 0;
+    for (int y = RS_MAX(cy - 1, 0); y <= RS_MIN(cy + 1, h - 1); y++)
+        for (int x = RS_MAX(cx - 1, 0); x <= RS_MIN(cx + 1, w - 1); x++, k++)
+            for (int c = 0; c < 3; c++) sum[c] += px[((size_t)y * w + x) * 4 + c];
+    free(px);
+    if (k == 0) return;
+    uint8_t rgb[3] = {(uint8_t)(sum[0] / k), (uint8_t)(sum[1] / k), (uint8_t)(sum[2] / k)};
+    vw_editor *e = &v->editor;
+    rs_cosmetic_set_rgb(&e->product, rgb);
+    rs_cosmetic_rgb_to_hsv(rgb, &e->hsv[0], &e->hsv[1], &e->hsv[2]);
+    edited(v);
+}
+
 bool vw_editor_key(vw_viewer *v, int key, int mods)
 {
     vw_editor *e = &v->editor;
@@ -133,6 +230,9 @@ bool vw_editor_key(vw_viewer *v, int key, int mods)
     bool shift = mods & GLFW_MOD_SHIFT;
     switch (key) {
     case GLFW_KEY_X: e->hex_entry = true, e->hex_len = 0, e->hex[0] = 0; return true;
+    case GLFW_KEY_V: pick_colour(v); return true;
+    case GLFW_KEY_ENTER:
+    case GLFW_KEY_KP_ENTER: keep_shade(v); return true;
     case GLFW_KEY_N: cycle_finish(v, shift ? -1 : 1); return true;
     case GLFW_KEY_COMMA: set_coverage(v, roundf(e->product.coverage * 10.0f - 1.0f) / 10.0f); return true;
     case GLFW_KEY_PERIOD: set_coverage(v, roundf(e->product.coverage * 10.0f + 1.0f) / 10.0f); return true;
@@ -224,4 +324,16 @@ void vw_editor_draw(vw_viewer *v, const rs_ui_toolbar_layout *tb)
     rs_ui_text(ui, l.coverage.x, l.coverage.y - 14 * s, RS_MAX(1, (int)floorf(s + 0.25f)), RS_UI_DIM, cov_text);
     snprintf(cov_text, sizeof cov_text, "%.0f%%", cov * 100.0f);
     if (rs_ui_slider(ui, ID_BASE + 20, l.coverage, RS_UI_ICON_DROP, NULL, cov_text, &cov)) set_coverage(v, cov);
+
+    rs_ui_text(ui, l.shades[0].x, l.shades[0].y - 14 * s, RS_MAX(1, (int)floorf(s + 0.25f)), RS_UI_DIM,
+               "My shades (Enter keeps this one)");
+    for (int i = 0; i < VW_SHADES_MAX; i++) {
+        if (i >= e->shade_count) {
+            rs_ui_stroke(ui, l.shades[i], 6 * s, 1.0f * s, RS_UI_DIM);
+            continue;
+        }
+        bool on = e->custom && !memcmp(e->shades[i].rgb, e->product.rgb, 3);
+        if (rs_ui_swatch(ui, ID_BASE + 30 + i, l.shades[i], e->shades[i].rgb, on)) use_shade(v, i);
+    }
+    if (rs_ui_text_button(ui, ID_BASE + 30 + VW_SHADES_MAX, l.shade_add, "+", false)) keep_shade(v);
 }

@@ -215,6 +215,9 @@ typedef struct vw_rung {
 } vw_rung;
 
 // The product editor (viewer_editor.c): a custom product derived from the selected preset.
+#define VW_SHADES_MAX 8
+#define VW_SHADES_FILE "shades.txt"  // one product a line, as rs_cosmetic_format writes it
+
 typedef struct vw_editor {
     bool open;
     bool custom;            // the brush paints `product` instead of the selected preset
@@ -223,11 +226,14 @@ typedef struct vw_editor {
     bool hex_entry;         // typing a colour as six hex digits (X, or a tap on the hex field)
     char hex[8];
     int hex_len;
+    rs_cosmetic shades[VW_SHADES_MAX];  // "my shades": kept in VW_SHADES_FILE in the look library's folder
+    int shade_count;
 } vw_editor;
 
 // Where the editor puts things (pure, for tests), framebuffer pixels.
 typedef struct vw_editor_layout {
     rs_ui_rect panel, close, sv, hue, swatch, hex, finish[RS_FINISH_COUNT], coverage;
+    rs_ui_rect shades[VW_SHADES_MAX], shade_add;  // the "my shades" row
 } vw_editor_layout;
 
 typedef struct vw_viewer {
@@ -363,6 +369,7 @@ void vw_editor_layout_compute(const rs_ui_toolbar_layout *toolbar, float scale, 
 const rs_cosmetic *vw_current_cosmetic(const vw_viewer *v);  // the custom product or the selected preset
 void vw_editor_sync(vw_viewer *v);     // show the selected preset (when no custom product is in use)
 void vw_editor_toggle(vw_viewer *v);   // C, the swatch row's Edit chip
+void vw_editor_load_shades(vw_viewer *v);  // "my shades" from the look library's folder (after vw_looks_init)
 bool vw_editor_key(vw_viewer *v, int key, int mods);  // true when the editor took the key
 bool vw_editor_char(vw_viewer *v, unsigned codepoint);
 void vw_editor_draw(vw_viewer *v, const rs_ui_toolbar_layout *toolbar);  // into v->ui; handles its input

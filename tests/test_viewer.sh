@@ -33,7 +33,8 @@ viewer_and_rouge_render_show_the_same_look viewer_region_brush_keeps_lipstick_on
 viewer_look_library_saves_refuses_clashes_loads_compares_deletes
 viewer_product_editor_paints_and_saves_a_custom_product
 viewer_slow_frames_lose_no_input_and_orbit_by_the_drag viewer_compare_and_export_do_what_they_say
-viewer_product_editor_keeps_the_face_at_full_quality"
+viewer_product_editor_keeps_the_face_at_full_quality viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek
+viewer_eyedropper_takes_the_face_colour_into_the_editor viewer_my_shades_persist_and_can_be_picked_again"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -639,6 +640,95 @@ if selected viewer_product_editor_keeps_the_face_at_full_quality; then
     if [ $rc -ne 0 ] || [ -z "$r1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/edq.log")"
     elif [ "$r0" = "$r1" ] || [ $((f - f0)) -lt 3 ]; then echo "FAIL - $name: the drag did not act over several frames ($r0 -> $r1, $((f - f0)) frames)"
     elif [ "$range" != "1.000 1.000" ]; then echo "FAIL - $name: the face was drawn at render scales $range while the colour moved"
+    else echo "ok - $name"; fi
+fi
+if selected viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek; then
+    # Issue 21: one key brings the lips (Shift+2), the eyes (Shift+1) or a cheek (Shift+3) to fill the view;
+    # 0 goes back. The lips sit below the face's centre (the picture moves up: pan y < 0), the eyes well
+    # above them.
+    name=viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek
+    {
+        echo "move 400 580"
+        echo "idle"
+        echo "state $out/z0.txt"
+        echo "key shift+2"
+        echo "idle"
+        echo "state $out/z1.txt"
+        echo "screenshot $out/z1_lips.png 80 80 630 330"
+        echo "key shift+1"
+        echo "idle"
+        echo "state $out/z2.txt"
+        echo "key shift+3"
+        echo "idle"
+        echo "state $out/z3.txt"
+        echo "key 0"
+        echo "idle"
+        echo "state $out/z4.txt"
+        echo "quit"
+    } >"$out/zoom.events"
+    view --events "$out/zoom.events" >"$out/zoom.log" 2>&1
+    rc=$?
+    zv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/z$1.txt" 2>/dev/null; }
+    if [ $rc -ne 0 ] || [ ! -f "$out/z4.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/zoom.log")"
+    elif ! echo "$(zv 1 zoom) $(zv 1 pan)" | awk '{ exit !($1 >= 2 && $3 < -0.1) }'; then
+        echo "FAIL - $name: Shift+2 did not zoom to the lips (zoom, pan: $(zv 1 zoom) $(zv 1 pan))"
+    elif ! echo "$(zv 2 zoom) $(zv 2 pan) $(zv 1 pan)" | awk '{ exit !($1 >= 2 && $3 > $5 + 0.5) }'; then
+        echo "FAIL - $name: Shift+1 did not zoom to the eyes (zoom, pan: $(zv 2 zoom) $(zv 2 pan))"
+    elif ! echo "$(zv 3 zoom) $(zv 3 pan)" | awk '{ exit !($1 >= 2 && ($2 > 0.1 || $2 < -0.1)) }'; then
+        echo "FAIL - $name: Shift+3 did not zoom to a cheek (zoom, pan: $(zv 3 zoom) $(zv 3 pan))"
+    elif [ "$(zv 4 zoom) $(zv 4 pan)" != "$(zv 0 zoom) $(zv 0 pan)" ]; then
+        echo "FAIL - $name: 0 did not bring the view back ($(zv 0 zoom) $(zv 0 pan) -> $(zv 4 zoom) $(zv 4 pan))"
+    else echo "ok - $name"; fi
+fi
+if selected viewer_eyedropper_takes_the_face_colour_into_the_editor; then
+    # Issue 21: V in the product editor takes the colour under the pointer from the rendered face: over
+    # the lips (zoomed to with Shift+2) the product turns lip red, whatever the preset was.
+    name=viewer_eyedropper_takes_the_face_colour_into_the_editor
+    {
+        echo "key shift+2"
+        echo "key c"
+        echo "move 300 320"
+        echo "idle"
+        echo "state $out/eye0.txt"
+        echo "key v"
+        echo "idle"
+        echo "state $out/eye1.txt"
+        echo "quit"
+    } >"$out/eyedrop.events"
+    view --events "$out/eyedrop.events" >"$out/eyedrop.log" 2>&1
+    rc=$?
+    rgb0=$(awk '$1 == "editor_rgb" {print $2, $3, $4}' "$out/eye0.txt" 2>/dev/null)
+    rgb1=$(awk '$1 == "editor_rgb" {print $2, $3, $4}' "$out/eye1.txt" 2>/dev/null)
+    if [ $rc -ne 0 ] || [ -z "$rgb1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/eyedrop.log")"
+    elif [ "$rgb0" = "$rgb1" ]; then echo "FAIL - $name: V left the editor's colour at $rgb0"
+    elif ! echo "$rgb1" | awk '{ exit !($1 - $2 >= 40 && $1 - $3 >= 30) }'; then
+        echo "FAIL - $name: the colour taken from the lips, $rgb1, is not lip red"
+    else echo "ok - $name"; fi
+fi
+if selected viewer_my_shades_persist_and_can_be_picked_again; then
+    # Issue 21: a custom shade (here taken from the lips with the eyedropper) kept with Enter goes into
+    # "my shades", a file beside the looks; the next session shows it in the editor's row, and a tap on it
+    # (the row's first swatch at (422, 408) 24x28 on an 800x600 window) paints with it again.
+    name=viewer_my_shades_persist_and_can_be_picked_again
+    rm -rf "$out/shade_looks"
+    printf 'key shift+2\nkey c\nmove 300 320\nidle\nkey v\nkey enter\nidle\nstate %s\nquit\n' "$out/sh0.txt" >"$out/shade0.events"
+    printf 'key c\nidle\nstate %s\nclick 434 422\nidle\nstate %s\nquit\n' "$out/sh1.txt" "$out/sh2.txt" >"$out/shade1.events"
+    "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade0.events" \
+        >"$out/shade0.log" 2>&1
+    rc0=$?
+    "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade1.events" \
+        >"$out/shade1.log" 2>&1
+    rc1=$?
+    sv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/sh$1.txt" 2>/dev/null; }
+    if [ $rc0 -ne 0 ] || [ $rc1 -ne 0 ] || [ ! -f "$out/sh2.txt" ]; then
+        echo "FAIL - $name: exit $rc0/$rc1: $(tail -c 300 "$out/shade0.log" "$out/shade1.log")"
+    elif [ "$(sv 0 shades)" != 1 ] || [ ! -s "$out/shade_looks/shades.txt" ]; then
+        echo "FAIL - $name: Enter kept $(sv 0 shades) shades, file: $(head -c 200 "$out/shade_looks/shades.txt" 2>&1)"
+    elif [ "$(sv 1 shades)" != 1 ]; then echo "FAIL - $name: the next session has $(sv 1 shades) shades"
+    elif [ "$(sv 1 editor_rgb)" = "$(sv 0 editor_rgb)" ]; then
+        echo "FAIL - $name: the editor already showed the kept shade before it was picked ($(sv 1 editor_rgb))"
+    elif [ "$(sv 2 editor_rgb)" != "$(sv 0 editor_rgb)" ]; then
+        echo "FAIL - $name: the tap on my shade gave $(sv 2 editor_rgb), kept $(sv 0 editor_rgb)"
     else echo "ok - $name"; fi
 fi
 if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then

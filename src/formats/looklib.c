@@ -97,6 +97,8 @@ static rs_result make_dirs(const char *dir, rs_error *err)
     return RS_OK;
 }
 
+rs_result rs_looklib_make_dir(const char *dir, rs_error *err) { return make_dirs(dir, err); }
+
 // The directory's entries (links, renames) reach the disk.
 static void sync_dir(const char *dir)
 {

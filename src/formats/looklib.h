@@ -39,6 +39,8 @@ rs_result rs_looklib_default_dir(char *out, size_t cap, rs_error *err);
 // RS_ERR_ARG with the reason ("name: '.' not allowed (letters, digits, space, - and _)") when `name`
 // cannot be a look's name.
 rs_result rs_looklib_check_name(const char *name, rs_error *err);
+// Creates the library's folder (and its parents) if missing: for files kept beside the looks.
+rs_result rs_looklib_make_dir(const char *dir, rs_error *err);
 
 // dir/NAME.look (thumb false) or dir/NAME.png (thumb true), after checking the name.
 rs_result rs_looklib_path(const char *dir, const char *name, bool thumb, char *out, size_t cap, rs_error *err);
