@@ -30,7 +30,11 @@ const char *rs_app_default_face(char *buf, size_t n)
 {
     snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
     if (access(buf, R_OK) == 0) return buf;
-    if (!beside_bin("share/rouge/face.rsf", buf, n) || access(buf, R_OK) != 0) snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
+    // Installed (<bin>/../share/rouge), or a source tree's build directory run from anywhere, like the
+    // environments (rs_app_env_dir).
+    if (beside_bin("share/rouge/face.rsf", buf, n) && access(buf, R_OK) == 0) return buf;
+    if (beside_bin("assets/face.rsf", buf, n) && access(buf, R_OK) == 0) return buf;
+    snprintf(buf, n, "%s", RS_APP_DEFAULT_FACE);
     return buf;
 }
 

@@ -662,7 +662,11 @@ static void feed_face(vw_viewer *v, rouge_pointer_type type, int id, float wx, f
     rouge_pointer_event ev = {type, id, wx * k, wy * k, 1.0f, t};
     rouge_pointer_result res;
     rouge_error e = {0};
-    if (rouge_face_pointer(v->face, &ev, &res, &e) != ROUGE_OK) vw_toast(v, true, "%s", e.msg);
+    if (rouge_face_pointer(v->face, &ev, &res, &e) != ROUGE_OK) {
+        vw_toast(v, true, "%s", e.msg);
+        // A recording's failed write can surface here instead of at the final flush: keep it for the exit.
+        if (v->cli->record && e.code == ROUGE_ERR_IO && !v->record_err.code) v->record_err = e;
+    }
     if (type == ROUGE_POINTER_UP || type == ROUGE_POINTER_CANCEL) v->face_pointers = RS_MAX(v->face_pointers - 1, 0);
     // Gestures come back in the face's pixels: back to window coordinates with the same scale.
     if (res.orbit_dx != 0 || res.orbit_dy != 0) orbit(v, res.orbit_dx / k, res.orbit_dy / k);
@@ -1220,6 +1224,7 @@ rs_result rs_app_view(const rs_cli *cli, rs_error *err)
         // Every stroke in the recording's file before the viewer says it is done.
         rouge_error e2 = {0};
         rouge_result fr = rouge_face_flush_strokes(v->face, &e2);
+        if (!fr && v->record_err.code) fr = v->record_err.code, e2 = v->record_err;
         if (!r) r = rs_app_error(fr, &e2, err);
     }
     load_abort(v);

@@ -238,6 +238,7 @@ typedef struct vw_editor_layout {
 
 typedef struct vw_viewer {
     const rs_cli *cli;
+    rouge_error record_err;  // the first failed write of the --record file (the exit reports it)
     rs_window *window;
     GLFWwindow *win;
     rs_ui *ui, *scene_ui;  // the interactive UI, and a second list for the picture (screenshots without UI)

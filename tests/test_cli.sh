@@ -27,6 +27,11 @@ no_file() {
 }
 
 expect cli_help_exits_zero 0 "" "$rouge" --help
+# A build directory's rouge finds the tree's face and environments from any working directory.
+abs_rouge=$(cd "$(dirname "$rouge")" && pwd)/rouge
+if (cd "$tmp" && "$abs_rouge" render -o "$tmp/anywhere.png" --size 32x32 --max-splats 2000 >/dev/null 2>"$tmp/err") &&
+    [ -s "$tmp/anywhere.png" ]; then echo "ok - cli_default_face_from_any_directory"
+else echo "FAIL - cli_default_face_from_any_directory: $(head -c 300 "$tmp/err")"; fi
 expect cli_unknown_flag 2 "unknown option '--frobnicate'" "$rouge" render "$face" -o "$tmp/a.png" --frobnicate
 expect cli_bad_number 2 "--yaw: expected a number" "$rouge" render "$face" -o "$tmp/a.png" --yaw abc
 expect cli_out_of_range 2 "--size" "$rouge" render "$face" -o "$tmp/a.png" --size 0x10
