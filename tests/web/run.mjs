@@ -322,6 +322,42 @@ if (main?.state === 'ready') {
         check('two fingers never paint', (await page.evaluate(() => window.rouge.stats().lookStamps)) === 0, 'no stamps');
     });
 
+    await run('two fingers twisting turn the head', async () => {
+        const v0 = await page.evaluate(() => window.rouge.getView());
+        const c = SIZE / 2, r = 30, ev = [];
+        const at = (deg) => [{ x: c + r * Math.cos(deg * Math.PI / 180), y: c + r * Math.sin(deg * Math.PI / 180), id: 1 },
+                             { x: c - r * Math.cos(deg * Math.PI / 180), y: c - r * Math.sin(deg * Math.PI / 180), id: 2 }];
+        ev.push(cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: at(0) }));
+        for (let d = 5; d <= 30; d += 5) ev.push(cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: at(d) }));
+        ev.push(cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] }));
+        await Promise.all(ev);
+        await settle(page);
+        const v1 = await page.evaluate(() => window.rouge.getView());
+        check('two fingers twisting turn the head', Math.abs(v1.yaw - v0.yaw - 30) < 3,
+              `yaw ${v0.yaw.toFixed(1)} -> ${v1.yaw.toFixed(1)} for a 30 deg twist`);
+    });
+
+    await run('while a pen is down, touches are ignored (palm rejection)', async () => {
+        await page.evaluate(() => window.rouge.setBrush({ cosmetic: 'blush' }));
+        const before = await page.evaluate(() => window.rouge.stats());
+        const c = SIZE / 2, pen = (type, x, buttons) => cdp.send('Input.dispatchMouseEvent', {
+            type, x, y: c, button: 'left', buttons, clickCount: 1, pointerType: 'pen', force: 0.8 });
+        await pen('mousePressed', c - 30, 1);
+        await cdp.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: [{ x: c, y: c + 60, id: 5 }] });
+        for (let i = 1; i <= 4; i++) {
+            await cdp.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: [{ x: c + 8 * i, y: c + 60, id: 5 }] });
+            await pen('mouseMoved', c - 30 + 12 * i, 1);
+        }
+        await cdp.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+        await pen('mouseReleased', c + 18, 0);
+        await settle(page);
+        const s = await page.evaluate(() => window.rouge.stats());
+        check('while a pen is down, touches are ignored (palm rejection)',
+              s.events - before.events === 6 && s.lookStamps > before.lookStamps,
+              `${s.events - before.events} events reached rouge (the pen's 6; the palm's 6 ignored), ` +
+              `${s.lookStamps - before.lookStamps} stamps`);
+    });
+
     await run('a stroke made while frames are slow keeps every event', async () => {
         await page.evaluate(() => window.rouge.setBrush({ cosmetic: 'blush' }));
         await page.evaluate(() => { window.rouge.options.frameDelayMs = 700; });  // what ?slow=700 sets
