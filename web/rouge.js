@@ -383,6 +383,9 @@ class Rouge {
     _draw() {
         this._resize();
         this._check(this.M._rw_draw(this.app, this.canvas.width, this.canvas.height));
+        // The frame's size, which pointer coordinates refer to: read once per frame, not per event.
+        const s = this.stats();
+        this.frameW = s.width, this.frameH = s.height;
         this.dirty = false;
         this.counts.frames++;
     }
@@ -399,8 +402,7 @@ class Rouge {
 
     // CSS pixels relative to the canvas -> pixels of the last frame (what rouge's picks and gestures use).
     _toFrame(x, y) {
-        const c = this.canvas, s = this.stats();
-        const w = s.width || c.width, h = s.height || c.height;
+        const c = this.canvas, w = this.frameW || c.width, h = this.frameH || c.height;
         return [x * w / Math.max(1, c.clientWidth || c.width), y * h / Math.max(1, c.clientHeight || c.height)];
     }
 

@@ -74,7 +74,6 @@ RW_API rw_app *rw_create(const char *canvas)
     }
     if (!current(a)) fail(a, ROUGE_ERR_GL, "the WebGL 2 context could not be made current");
     a->painting = true;
-    a->view.width = a->view.height = 0;
     return a;
 }
 
