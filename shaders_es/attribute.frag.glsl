@@ -11,7 +11,7 @@ precision highp float;
 precision highp int;
 #include "splat_ray.glsl"
 
-uniform float u_coverage;  // disks are drawn out to this many radii (render_internal.h RS_COVERAGE)
+uniform float u_coverage;  // disks are drawn out to this many radii (render_kit.h RS_COVERAGE)
 
 uniform float u_inv_two_sigma2;   // 1 / (2 sigma^2), sigma in disk radii
 uniform float u_weight_scale;

@@ -6,7 +6,7 @@ precision highp float;
 precision highp int;
 #include "splat_ray.glsl"
 
-uniform float u_coverage;  // disks are drawn out to this many radii (render_internal.h RS_COVERAGE)
+uniform float u_coverage;  // disks are drawn out to this many radii (render_kit.h RS_COVERAGE)
 
 uniform float u_eps;   // view units; 0 for the shadow map and the ID buffer
 

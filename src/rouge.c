@@ -47,7 +47,7 @@ _Static_assert((int)ROUGE_ERR_CANCELLED == (int)RS_ERR_ARG + 1, "ROUGE_ERR_CANCE
 #define ZOOM_MAX 12.0f
 #define PIXEL_RATIO_MIN 0.1f
 #define PIXEL_RATIO_MAX 16.0f
-#define MAX_TEXTURE_UNITS 8  // the renderer uses units 0..RS_UNIT_LEVEL (render_internal.h)
+#define MAX_TEXTURE_UNITS 8  // the renderer uses units 0..RS_UNIT_LEVEL (render_kit.h)
 
 // A stroke recording is rewritten whole after each stroke (temp file, fsync, rename: the file on disk is
 // always a complete recording). The writing happens on this thread, so ending a stroke costs only turning
@@ -800,7 +800,7 @@ rouge_result rouge_face_target(rouge_face *f, const char *region, float fill, ro
     // Size: twice the RMS distance of those splats from their centre.
     double ss = fmax(q - cn * (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]), 0.0);
     double size = 2.0 * sqrt(ss / (double)cn);
-    // Zoom moves the camera along its ray towards the face centre (render.c: distance = 0.625 H /
+    // Zoom moves the camera along its ray towards the face centre (render_view.c: distance = 0.625 H /
     // tan(fov/2) / zoom). Put it where the region, d_r in front of the centre, spans `fill` of the view.
     float toward[3], hc[3] = {h->centre[0], h->centre[1], h->centre[2]};
     rs_render_view_dir(f->ren, &v, hc, toward);

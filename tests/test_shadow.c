@@ -3,7 +3,7 @@
 // geometry puts it, x = -h tan(theta), within 0.3 mm; and lit surfaces do not shadow themselves (no acne)
 // on the floor and on a sphere lit at every angle up to near grazing.
 #include "support/harness.h"
-#include "render/render_internal.h"  // RS_COVERAGE: how far the disks reach
+#include "render/render_kit.h"  // RS_COVERAGE: how far the disks reach
 
 #include <math.h>
 #include <stdio.h>

@@ -30,7 +30,7 @@ typedef struct rs_env_level {
 // Frame: the face frame, x = right (the subject's left, image right in a frontal view), y = up, z = forward
 // (out of the face). Equirect texel (i, j) has its centre at u = (i + .5) / W, v = (j + .5) / H,
 // phi = 2 pi (u - 0.5), theta = pi v, d = (sin theta sin phi, cos theta, sin theta cos phi): phi is a
-// light's yaw, 90 deg - theta its pitch (render.c frame_dir).
+// light's yaw, 90 deg - theta its pitch (render_view.c frame_dir).
 typedef struct rs_env {
     char name[32];                     // "studio"
     char notes[RS_ENV_MAX_NOTES];      // source, author, licence, how it was made (shown by --help, README)

@@ -1,4 +1,4 @@
-// render.c — the renderer object (GPU buffers, programs, targets), the camera, and the frame that runs the
+// render.c — the orchestrator: the renderer object (GPU buffers, targets), and the frame that runs the
 // paper's five stages in order (Fig. 2): shadow map, visibility, attributes, diffusion, composite.
 // Pass order and what each reads: (1) shadow map (splats from the light); (2) visibility depth; (3)
 // attributes: per-splat albedo with the makeup's splat layer composed in (makeup.glsl), normal, m, rho_s,
@@ -6,15 +6,14 @@
 // albedo and finish); (5) composite: normalises (3), composes the makeup's fine layer per pixel at the
 // surface point from (2) (render_fine.c: stamps + grid in textures never attached to a framebuffer), then
 // F = A (D + S). A stamp's frame re-runs (3) and (5) only, inside its rectangle (incremental_frame).
-#include "render/render_internal.h"
-
-#include "gl/shader.h"
+// Layering (STYLE.md rule 15): this file sits above the stages (render_stages.h), which sit above the kit
+// (render_kit.h: state, camera and frame in render_view.c, GL toolbox in render_kit.c); only this file calls
+// the stages, and no stage calls into it (tests/test_layering.sh checks the objects).
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-
-#define DEG2RAD(d) ((d) * 0.017453292519943295f)
 
 // Display defaults: a dark neutral grey behind the face, and a key light from the upper left-front
 // (the classic portrait "loop light": cheek and nose shadow on the far side).
@@ -34,364 +33,6 @@ rs_view rs_view_defaults(void)
         .rho_s_scale = 1.0f,
         .ambient = 0.05f,
     };
-}
-
-// ---- camera ----
-
-// Unit vector of direction (yaw, pitch) in the face frame: yaw turns from `forward` towards the
-// subject's left (image right), pitch towards `up`.
-static void frame_dir(const rs_splat_header *h, float yaw_deg, float pitch_deg, vec3 out)
-{
-    vec3 f, u, right;
-    glm_vec3_normalize_to((float *)h->forward, f);
-    glm_vec3_copy((float *)h->up, u);
-    // Up made orthogonal to forward (the header only promises "not parallel").
-    vec3 tmp;
-    glm_vec3_scale(f, glm_vec3_dot(f, u), tmp);
-    glm_vec3_sub(u, tmp, u);
-    glm_vec3_normalize(u);
-    glm_vec3_cross(u, f, right);
-    float y = DEG2RAD(yaw_deg), p = DEG2RAD(pitch_deg);
-    for (int a = 0; a < 3; a++)
-        out[a] = cosf(p) * (cosf(y) * f[a] + sinf(y) * right[a]) + sinf(p) * u[a];
-}
-
-// The host's camera (rs_view.use_matrices): near and far come from the perspective projection
-// (P[2][2] = -(f+n)/(f-n), P[3][2] = -2fn/(f-n)), the pixel size from its focal length.
-static void host_camera(const rs_renderer *r, const rs_view *v, rs_camera *cam)
-{
-    memcpy(cam->view, v->view_matrix, sizeof cam->view);
-    memcpy(cam->proj, v->proj_matrix, sizeof cam->proj);
-    glm_mat4_inv(cam->view, cam->inv_view);
-    glm_mat4_inv(cam->proj, cam->inv_proj);
-    for (int a = 0; a < 3; a++) cam->eye[a] = cam->inv_view[3][a];
-    cam->near_z = cam->proj[3][2] / (cam->proj[2][2] - 1.0f);
-    cam->far_z = cam->proj[3][2] / (cam->proj[2][2] + 1.0f);
-    cam->width = v->width;
-    cam->height = v->height;
-    cam->px_size = 2.0f / (cam->proj[1][1] * (float)v->height);
-    vec3 bc = {r->bound_centre[0], r->bound_centre[1], r->bound_centre[2]};
-    float bd = glm_vec3_distance(cam->eye, bc);
-    cam->ppu_max = 1.0f / (cam->px_size * fmaxf(bd - r->bound_radius, cam->near_z));
-}
-
-void rs_render_camera(const rs_renderer *r, const rs_view *v, rs_camera *cam)
-{
-    if (v->use_matrices) {
-        host_camera(r, v, cam);
-        return;
-    }
-    const rs_splat_header *h = &r->cloud->hdr;
-    float pitch = RS_CLAMP(v->pitch_deg, -89.0f, 89.0f);
-    vec3 d, up;
-    frame_dir(h, v->yaw_deg, pitch, d);
-    // The camera's up: the face's up tilted with the pitch (never parallel to d).
-    frame_dir(h, v->yaw_deg, pitch + 90.0f, up);
-    float half_fov = DEG2RAD(v->fov_deg) * 0.5f;
-    // Face height fills ~80% of the view height at zoom 1.
-    float dist = h->face_height * 0.5f / 0.8f / tanf(half_fov) / v->zoom;
-    vec3 centre = {h->centre[0], h->centre[1], h->centre[2]};
-    for (int a = 0; a < 3; a++) cam->eye[a] = centre[a] + d[a] * dist;
-    glm_lookat(cam->eye, centre, up, cam->view);
-    glm_mat4_inv(cam->view, cam->inv_view);
-
-    // Near/far from the cloud's bounding sphere, so depth precision is spent on the face.
-    vec3 bc = {r->bound_centre[0], r->bound_centre[1], r->bound_centre[2]};
-    float bd = glm_vec3_distance(cam->eye, bc), R = r->bound_radius;
-    cam->far_z = bd + R * 1.01f;
-    cam->near_z = fmaxf(bd - R * 1.01f, cam->far_z * 1e-3f);
-    float aspect = (float)v->width / (float)v->height;
-    glm_perspective(2.0f * half_fov, aspect, cam->near_z, cam->far_z, cam->proj);
-    // Pan: a shift in normalised device coordinates (fractions of the view height; +x right, +y down).
-    mat4 pan;
-    glm_translate_make(pan, (vec3){2.0f * v->pan[0] / aspect, -2.0f * v->pan[1], 0.0f});
-    glm_mat4_mul(pan, cam->proj, cam->proj);
-    glm_mat4_inv(cam->proj, cam->inv_proj);
-    cam->width = v->width;
-    cam->height = v->height;
-    cam->px_size = 2.0f * tanf(half_fov) / (float)v->height;
-    cam->ppu_max = 1.0f / (cam->px_size * fmaxf(bd - R, cam->near_z));
-}
-
-// Fills the zero-means-default fields.
-static rs_view view_resolved(const rs_view *in)
-{
-    rs_view v = *in;
-    if (v.zoom <= 0) v.zoom = 1.0f;
-    if (v.fov_deg <= 0) v.fov_deg = 30.0f;
-    if (v.exposure <= 0) v.exposure = 1.0f;
-    if (v.rho_s_scale <= 0) v.rho_s_scale = 1.0f;
-    if (!(v.lod_density > 0)) v.lod_density = RS_LOD_DENSITY_DEFAULT;
-    if (!(v.env_intensity > 0)) v.env_intensity = 1.0f;
-    if (v.key.intensity <= 0) v.key.intensity = 1.0f;
-    rs_light *lights[2] = {&v.key, &v.fill};
-    for (int i = 0; i < 2; i++)
-        if (lights[i]->color[0] <= 0 && lights[i]->color[1] <= 0 && lights[i]->color[2] <= 0)
-            lights[i]->color[0] = lights[i]->color[1] = lights[i]->color[2] = 1.0f;
-    return v;
-}
-
-// The face's screen area in pixels (*face_px) and the number of splats of the whole cloud per visible
-// splat (the returned ratio A_total / A_visible), from an even subsample (the coarsest LOD prefix): each
-// sample stands for area_total / n of the surface, and counts when it faces the camera and projects into
-// the view, with its foreshortening (n.v) over its squared distance. Overlapping layers (an ear in front
-// of the cheek) count twice: a few percent on a face (measured within 2% of the covered pixels).
-static float face_pixels(const rs_renderer *r, const rs_camera *cam, float *face_px)
-{
-    const rs_splat_cloud *c = r->cloud;
-    const rs_splat_header *h = &c->hdr;
-    uint32_t n = h->lod_count > 0 ? h->lods[h->lod_count - 1] : h->count;
-    // Without a coarse LOD level, every k-th record.
-    uint32_t step = 1;
-    if (h->lod_count <= 1 || n > 40000) {
-        step = RS_MAX(h->count / 20000u, 1u);
-        n = h->count;
-    }
-    mat4 vp;
-    glm_mat4_mul((vec4 *)cam->proj, (vec4 *)cam->view, vp);
-    double solid = 0;
-    uint32_t visible = 0, samples = 0;
-    for (uint32_t i = 0; i < n; i += step) {
-        samples++;
-        vec3 d = {cam->eye[0] - c->pos[i][0], cam->eye[1] - c->pos[i][1], cam->eye[2] - c->pos[i][2]};
-        float facing = glm_vec3_dot(d, c->normal[i]);
-        if (facing <= 0) continue;
-        vec4 p = {c->pos[i][0], c->pos[i][1], c->pos[i][2], 1.0f}, q;
-        glm_mat4_mulv(vp, p, q);
-        if (!(q[3] > 0 && fabsf(q[0]) <= q[3] && fabsf(q[1]) <= q[3])) continue;
-        float dist2 = glm_vec3_dot(d, d);
-        solid += facing / (dist2 * sqrtf(dist2));
-        visible++;
-    }
-    float per_sample = r->area_total / (float)samples;
-    *face_px = (float)(solid * per_sample) / (cam->px_size * cam->px_size);
-    return visible ? (float)samples / (float)visible : 0.0f;
-}
-
-// Splats in the main passes: the max_splats cap; the mobile pipeline also the LOD prefix nearest (in log)
-// to lod_density visible splats per pixel of the face's screen area (the prefix is spread evenly over
-// the whole surface, so it holds `ratio` times the visible ones). The LOD table steps by ~2x: the density
-// drawn is within ~0.7x..1.4x of the asked one. Zooming in raises it, up to the whole cloud; small views
-// stop at RS_MOBILE_MAX_LOD_STEPS below the cap.
-static uint32_t main_count(const rs_renderer *r, const rs_view *v, const rs_camera *cam, float *face_px)
-{
-    const rs_splat_header *h = &r->cloud->hdr;
-    uint32_t n = h->count;
-    if (v->max_splats > 0 && v->max_splats < n) n = rs_splat_lod_count(r->cloud, v->max_splats);
-    *face_px = 0;
-    if (v->pipeline != RS_PIPELINE_MOBILE) return n;
-    float density = v->lod_density > 0 ? v->lod_density : RS_LOD_DENSITY_DEFAULT;
-    float ratio = face_pixels(r, cam, face_px);
-    double want = fmax((double)density * *face_px * ratio, 1.0);
-    uint32_t best = n, steps = 0;
-    double best_err = INFINITY;
-    for (uint32_t k = 0; k < h->lod_count; k++) {
-        uint32_t m = h->lods[k];
-        if (m > n) continue;
-        if (m < n && ++steps > RS_MOBILE_MAX_LOD_STEPS) break;
-        double e = fabs(log((double)m / want));
-        if (e < best_err) best_err = e, best = m;
-    }
-    return best;
-}
-
-uint32_t rs_render_auto_splats(const rs_renderer *r, const rs_view *view)
-{
-    rs_view v = view_resolved(view);
-    if (v.width <= 0 || v.height <= 0) return 0;
-    rs_camera cam;
-    rs_render_camera(r, &v, &cam);
-    float face_px;
-    return main_count(r, &v, &cam, &face_px);
-}
-
-bool rs_render_needs_quads(const rs_renderer *r, const rs_frame *f, float radius)
-{
-    float size = 2.0f * radius * f->cam.ppu_max * 1.15f + 2.0f;
-    return size > r->caps.point_size_max;
-}
-
-void rs_render_frame_setup(const rs_renderer *r, const rs_view *view, rs_frame *f)
-{
-    memset(f, 0, sizeof *f);
-    f->view = view_resolved(view);
-    const rs_view *v = &f->view;
-    rs_render_camera(r, v, &f->cam);
-    f->mobile = v->pipeline == RS_PIPELINE_MOBILE;
-    f->shadow_slot = f->mobile ? 1 : 0;
-    f->count = main_count(r, v, &f->cam, &f->face_px);
-    f->radius_scale = rs_splat_lod_radius_scale(r->cloud, f->count);
-    if (f->mobile) {
-        // Even prefixes close the surface with smaller radii than sqrt(N / n) x the full cloud's
-        // (RS_MOBILE_COVER), never below the full cloud's own: the reconstruction filter, and with it
-        // the silhouette, stays as close as the sampling allows to the reference's of all splats.
-        f->radius_scale = fmaxf(1.0f, RS_MOBILE_COVER * f->radius_scale);
-    }
-    float rmax = r->cloud->hdr.radius_max * f->radius_scale * RS_COVERAGE;
-    f->quads = v->prim == RS_PRIM_QUADS || (v->prim == RS_PRIM_AUTO && rs_render_needs_quads(r, f, rmax));
-    // Half a typical splat radius: overlapping splats of one surface blend, a surface behind (the far
-    // side of a lip, an ear) stays hidden. Constant per frame so stage 4 and 5 can undo it exactly.
-    f->eps = 0.5f * r->radius_median * f->radius_scale;
-
-    rs_render_mode m = v->mode;
-    f->lit = m == RS_MODE_FULL || m == RS_MODE_DIFFUSE || m == RS_MODE_SPECULAR || m == RS_MODE_SHADOW ||
-             m == RS_MODE_IRRADIANCE;
-    f->diffuse = m == RS_MODE_FULL || m == RS_MODE_DIFFUSE;
-    f->shadows = f->lit && !v->no_shadows;
-
-    const rs_splat_header *h = &r->cloud->hdr;
-    vec3 d;
-    mat3 rot;
-    glm_mat4_pick3(f->cam.view, rot);
-    f->env_on = f->lit && v->lighting == RS_LIGHTING_ENV && r->env.on;
-    if (f->env_on) {
-        // The environment's frame is the face frame (x right = the subject's left, y up, z forward)
-        // turned by env_rotate_deg about up. Its brightest region is the key light.
-        vec3 right, up, fwd;
-        frame_dir(h, 90.0f, 0.0f, right);
-        frame_dir(h, 0.0f, 90.0f, up);
-        frame_dir(h, 0.0f, 0.0f, fwd);
-        float a = DEG2RAD(v->env_rotate_deg), ca = cosf(a), sa = sinf(a);
-        // Face-frame coordinates -> environment coordinates: a turn by -a about y.
-        mat3 face_to_env = {{ca, 0, sa}, {0, 1, 0}, {-sa, 0, ca}};
-        mat3 model_to_face = {{right[0], up[0], fwd[0]}, {right[1], up[1], fwd[1]}, {right[2], up[2], fwd[2]}};
-        mat3 inv_rot, m2;
-        glm_mat4_pick3(f->cam.inv_view, inv_rot);
-        glm_mat3_mul(model_to_face, inv_rot, m2);
-        glm_mat3_mul(face_to_env, m2, f->env_from_view);
-        // The light back: environment -> view is the transpose (all rotations).
-        mat3 view_from_env;
-        glm_mat3_transpose_to(f->env_from_view, view_from_env);
-        glm_mat3_mulv(view_from_env, (float *)r->env.light_dir, f->key_dir);
-        glm_vec3_normalize(f->key_dir);
-        glm_vec3_scale((float *)r->env.light_color, v->env_intensity, f->key_color);
-        f->key_widen = 0.5f * r->env.light_angle;
-        return;
-    }
-    frame_dir(h, v->key.yaw_deg, v->key.pitch_deg, d);
-    glm_mat3_mulv(rot, d, f->key_dir);
-    glm_vec3_scale((float *)v->key.color, v->key.intensity, f->key_color);
-    frame_dir(h, v->fill.yaw_deg, v->fill.pitch_deg, d);
-    glm_mat3_mulv(rot, d, f->fill_dir);
-    if (v->fill.intensity > 0) glm_vec3_scale((float *)v->fill.color, v->fill.intensity, f->fill_color);
-    float amb = fmaxf(v->ambient, 0.0f);
-    glm_vec3_fill(f->ambient, amb);
-}
-
-// ---- GL helpers ----
-
-GLuint rs_render_texture(GLenum internal_format, int w, int h)
-{
-    GLuint t;
-    glGenTextures(1, &t);
-    glBindTexture(GL_TEXTURE_2D, t);
-    glTexStorage2D(GL_TEXTURE_2D, 1, internal_format, w, h);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
-    return t;
-}
-
-void rs_render_bind_texture(int unit, GLuint tex)
-{
-    glActiveTexture(GL_TEXTURE0 + (GLenum)unit);
-    glBindTexture(GL_TEXTURE_2D, tex);
-}
-
-rs_result rs_render_fbo_check(const char *what, rs_error *err)
-{
-    GLenum s = glCheckFramebufferStatus(GL_FRAMEBUFFER);
-    if (s == GL_FRAMEBUFFER_COMPLETE) return RS_OK;
-    return rs_fail(err, RS_ERR_GL, "render: %s: framebuffer incomplete (status 0x%04x)", what, s);
-}
-
-static const char *const prog_files[RS_PROG_COUNT][2] = {
-    [RS_PROG_SHADOW] = {"visibility.vert.glsl", "visibility.frag.glsl"},
-    [RS_PROG_VISIBILITY] = {"visibility.vert.glsl", "visibility.frag.glsl"},
-    [RS_PROG_PICK] = {"visibility.vert.glsl", "visibility.frag.glsl"},
-    [RS_PROG_ATTRIBUTE] = {"attribute.vert.glsl", "attribute.frag.glsl"},
-    [RS_PROG_DIFFUSION] = {"diffusion.vert.glsl", "diffusion.frag.glsl"},
-    [RS_PROG_RESOLVE] = {"fullscreen.vert.glsl", "diffusion_resolve.frag.glsl"},
-    [RS_PROG_COMPOSITE] = {"fullscreen.vert.glsl", "composite.frag.glsl"},
-    [RS_PROG_IRRADIANCE] = {"irradiance.vert.glsl", "irradiance.frag.glsl"},
-};
-
-static const char *const prog_defines[RS_PROG_COUNT] = {
-    [RS_PROG_SHADOW] = "#define RS_SHADOW 1\n",
-    [RS_PROG_PICK] = "#define RS_PICK 1\n",
-};
-
-rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *out, rs_error *err)
-{
-    int q = kind < RS_PROG_SPLAT_COUNT && quads ? 1 : 0;
-    if (r->prog[kind][q]) {
-        *out = r->prog[kind][q];
-        return RS_OK;
-    }
-    char defines[128];
-    snprintf(defines, sizeof defines, "%s%s", prog_defines[kind] ? prog_defines[kind] : "",
-             q ? "#define RS_QUADS 1\n" : "");
-    GLuint p = 0;
-    rs_result res = rs_shader_program(prog_files[kind][0], prog_files[kind][1], defines, &p, err);
-    if (res != RS_OK) return res;
-    if (kind == RS_PROG_IRRADIANCE) {
-        // Feedback varyings must be named before linking: the shaders are still attached, so link again.
-        const char *varyings[1] = {"v_irradiance"};
-        glTransformFeedbackVaryings(p, 1, varyings, GL_INTERLEAVED_ATTRIBS);
-        glLinkProgram(p);
-        GLint ok = 0;
-        glGetProgramiv(p, GL_LINK_STATUS, &ok);
-        if (!ok) {
-            char log[512] = "";
-            glGetProgramInfoLog(p, sizeof log, NULL, log);
-            glDeleteProgram(p);
-            return rs_fail(err, RS_ERR_GL, "shader link error (irradiance transform feedback): %.400s", log);
-        }
-    }
-    // Constants of the program: the record's quantization frame, the texture units.
-    const rs_splat_header *h = &r->cloud->hdr;
-    glUseProgram(p);
-    glUniform3fv(rs_uloc(p, "u_bbox_min"), 1, h->bbox_min);
-    float step[3];
-    for (int a = 0; a < 3; a++) step[a] = (h->bbox_max[a] - h->bbox_min[a]) / 65535.0f;
-    glUniform3fv(rs_uloc(p, "u_bbox_step"), 1, step);
-    glUniform2f(rs_uloc(p, "u_radius_log"), h->radius_min, logf(h->radius_max / h->radius_min) / 255.0f);
-    glUniform1i(rs_uloc(p, "u_depth"), RS_UNIT_DEPTH);
-    glUniform1i(rs_uloc(p, "u_shadow_map"), RS_UNIT_SHADOW);
-    glUniform1i(rs_uloc(p, "u_attr0"), RS_UNIT_ATTR0);
-    glUniform1i(rs_uloc(p, "u_attr1"), RS_UNIT_ATTR1);
-    glUniform1i(rs_uloc(p, "u_attr2"), RS_UNIT_ATTR2);
-    glUniform1i(rs_uloc(p, "u_diffuse"), RS_UNIT_DIFFUSE);
-    glUniform1i(rs_uloc(p, "u_level"), RS_UNIT_LEVEL);
-    glUniform1i(rs_uloc(p, "u_env_map"), RS_UNIT_ENV);
-    glUniform1i(rs_uloc(p, "u_spec_lut"), RS_UNIT_SPEC_LUT);
-    glUniform1f(rs_uloc(p, "u_has_ao"), (h->flags & RS_SPLAT_FLAG_AO) ? 1.0f : 0.0f);
-    r->prog[kind][q] = p;
-    *out = p;
-    return RS_OK;
-}
-
-void rs_render_splat_uniforms(GLuint p, const mat4 view, const mat4 proj, const mat4 inv_proj, int w, int h,
-                              bool persp, float radius_scale, float cull_cos, float point_max)
-{
-    glUniformMatrix4fv(rs_uloc(p, "u_view"), 1, GL_FALSE, (const float *)view);
-    glUniformMatrix4fv(rs_uloc(p, "u_proj"), 1, GL_FALSE, (const float *)proj);
-    glUniformMatrix4fv(rs_uloc(p, "u_inv_proj"), 1, GL_FALSE, (const float *)inv_proj);
-    glUniform2f(rs_uloc(p, "u_viewport"), (float)w, (float)h);
-    glUniform1f(rs_uloc(p, "u_persp"), persp ? 1.0f : 0.0f);
-    glUniform1f(rs_uloc(p, "u_radius_scale"), radius_scale);
-    glUniform1f(rs_uloc(p, "u_cull_cos"), cull_cos);
-    glUniform1f(rs_uloc(p, "u_point_max"), point_max);
-    glUniform1f(rs_uloc(p, "u_coverage"), RS_COVERAGE);
-}
-
-void rs_render_draw_splats(const rs_renderer *r, uint32_t count, bool quads)
-{
-    if (count == 0) return;
-    glBindVertexArray(quads ? r->vao_quads : r->vao_points);
-    if (quads) glDrawArraysInstanced(GL_TRIANGLE_STRIP, 0, 4, (GLsizei)count);
-    else glDrawArrays(GL_POINTS, 0, (GLsizei)count);
 }
 
 // ---- create / destroy ----
@@ -652,7 +293,6 @@ static bool same_view(const rs_view *a, const rs_view *b)
                                  !memcmp(a->proj_matrix, b->proj_matrix, sizeof a->proj_matrix)));
 }
 
-void rs_render_invalidate(rs_renderer *r) { r->inc_valid = false; }
 uint32_t rs_render_incremental_frames(const rs_renderer *r) { return r->inc_frames; }
 
 // Grows the dirty rectangle by the splats [first, first + count) of the last full frame's prefix, as the
@@ -674,25 +314,6 @@ static void mark_dirty(rs_renderer *r, uint32_t first, uint32_t count)
         d[0] = fminf(d[0], x - rad), d[1] = fminf(d[1], y - rad);
         d[2] = fmaxf(d[2], x + rad), d[3] = fmaxf(d[3], y + rad);
     }
-}
-
-void rs_render_mark_dirty_sphere(rs_renderer *r, const float pos[3], float radius)
-{
-    const rs_camera *cam = &r->inc_cam;
-    vec4 p = {pos[0], pos[1], pos[2], 1.0f}, v, c;
-    glm_mat4_mulv((vec4 *)cam->view, p, v);
-    float *d = r->dirty;
-    if (v[2] > -radius) {  // reaches the camera plane: the whole target
-        d[0] = d[1] = -INFINITY, d[2] = d[3] = INFINITY;
-        return;
-    }
-    glm_mat4_mulv((vec4 *)cam->proj, v, c);
-    float focal = cam->proj[1][1] * 0.5f * (float)cam->height;
-    float x = (c[0] / c[3] * 0.5f + 0.5f) * (float)cam->width, y = (c[1] / c[3] * 0.5f + 0.5f) * (float)cam->height;
-    // The sphere's projection fits within radius / (distance - radius); 2 pixels for the composite's 3x3 reads.
-    float rad = radius * focal / (-v[2] - radius) + 2.0f;
-    d[0] = fminf(d[0], x - rad), d[1] = fminf(d[1], y - rad);
-    d[2] = fmaxf(d[2], x + rad), d[3] = fmaxf(d[3], y + rad);
 }
 
 static void clear_dirty(rs_renderer *r)
@@ -866,53 +487,6 @@ rs_result rs_render_image(rs_renderer *r, const rs_view *view, rs_image *out, rs
 {
     rs_result res = rs_render_frame(r, view, err);
     return res == RS_OK ? rs_render_read(r, out, err) : res;
-}
-
-// ---- queries for brushes and the viewer ----
-
-float rs_render_pixels_per_unit(const rs_renderer *r, const rs_view *view, const float pos[3])
-{
-    rs_view v = view_resolved(view);
-    rs_camera cam;
-    rs_render_camera(r, &v, &cam);
-    vec4 p = {pos[0], pos[1], pos[2], 1.0f}, q;
-    glm_mat4_mulv(cam.view, p, q);
-    float dist = fmaxf(-q[2], cam.near_z);
-    return 1.0f / (cam.px_size * dist);
-}
-
-void rs_render_view_dir(const rs_renderer *r, const rs_view *view, const float pos[3], float dir[3])
-{
-    rs_view v = view_resolved(view);
-    rs_camera cam;
-    rs_render_camera(r, &v, &cam);
-    vec3 d = {cam.eye[0] - pos[0], cam.eye[1] - pos[1], cam.eye[2] - pos[2]};
-    glm_vec3_normalize(d);
-    dir[0] = d[0], dir[1] = d[1], dir[2] = d[2];
-}
-
-void rs_render_view_matrices(const rs_renderer *r, const rs_view *view, float view_m[16], float proj_m[16])
-{
-    rs_view v = view_resolved(view);
-    rs_camera cam;
-    rs_render_camera(r, &v, &cam);
-    memcpy(view_m, cam.view, sizeof cam.view);
-    memcpy(proj_m, cam.proj, sizeof cam.proj);
-}
-
-bool rs_render_project(const rs_renderer *r, const rs_view *view, const float pos[3], float px[2])
-{
-    rs_view v = view_resolved(view);
-    rs_camera cam;
-    rs_render_camera(r, &v, &cam);
-    mat4 vp;
-    glm_mat4_mul(cam.proj, cam.view, vp);
-    vec4 p = {pos[0], pos[1], pos[2], 1.0f}, c;
-    glm_mat4_mulv(vp, p, c);
-    if (c[3] <= 1e-6f) return false;
-    px[0] = (c[0] / c[3] * 0.5f + 0.5f) * (float)v.width;
-    px[1] = (0.5f - c[1] / c[3] * 0.5f) * (float)v.height;
-    return true;
 }
 
 rs_result rs_render_update_makeup(rs_renderer *r, uint32_t first, uint32_t count, const void *records,

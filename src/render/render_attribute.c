@@ -11,7 +11,7 @@
 // at 256^2 / 50k splats); what remains is 8-bit blending noise where few splats overlap (brows, creases
 // next to occluding edges). Every GLES 3 GPU we know of has EXT_color_buffer_half_float; the fallback
 // exists so the viewer still runs without it.
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <string.h>

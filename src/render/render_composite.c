@@ -5,7 +5,7 @@
 // environment: a dielectric's white highlight), plus the makeup's clear coat and flakes; then exposure
 // and sRGB into the RGBA8 output. The makeup's fine layer (narrow brushes) is composed per pixel here, over
 // the splat layer's A, m, rho_s, coat and flakes (render_fine.c). The debug views are branches of the same pass.
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 

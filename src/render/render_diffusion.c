@@ -31,7 +31,7 @@
 // halved; wide levels use the mobile LOD factor (fewer, larger contributions lose less to 8-bit
 // rounding); the resolve clamps E to its possible range, and a pixel whose level weight is under 16
 // steps (reached only by kernels' faint tails) borrows its 3x3 neighbours' sums. Coarser, but it runs.
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <string.h>

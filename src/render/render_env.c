@@ -2,7 +2,7 @@
 // mip levels are the roughness levels), its SH irradiance and dominant light (uniforms), the exposure
 // normalisation that makes every environment light the face about as brightly, and the lookup table of
 // the specular lobe's directional albedo that turns prefiltered radiance into reflected light (split sum).
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -4,7 +4,7 @@
 // model-space grid over them (cell >= the widest stamp's diameter, so a stamp is listed in at most 8 cells)
 // into an R32UI texture: per cell (start, count), then the stamp lists in log order. Both are read with
 // texelFetch only and never attached to a framebuffer (WebGL 2 rejects feedback loops).
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -3,7 +3,7 @@
 // index + 1 into an R32UI target (0 = background). Rendered on demand and cached while the view's
 // geometry (size, camera, LOD, primitive) stays the same, so a stroke of many stamps renders it once;
 // read back whole at that time, so each pick is a lookup in memory, not a pipeline stall.
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <stdlib.h>

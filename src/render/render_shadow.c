@@ -4,7 +4,7 @@
 // own plane (receiver-plane depth bias, no normal offset) on a turned 4x4 grid of hardware 2x2 PCF. The
 // map only depends on the light and the LOD, so it is cached across camera moves, one per pipeline (the
 // mobile one at a quarter of the resolution, from the mobile LOD prefix).
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 #include <math.h>
 #include <string.h>

@@ -1,7 +1,7 @@
 // render_visibility.c — stage 2, visibility splatting (Botsch et al. 2005; paper Fig. 2): a depth-only pass
 // of the splats as disks (per-pixel ray-disk intersection), each hit pushed back by frame->eps along its
 // view ray, so that stage 3 blends every splat of the front surface layer and nothing behind it.
-#include "render/render_internal.h"
+#include "render/render_stages.h"
 
 // Splats facing away beyond this are dropped (their front-facing neighbours cover the silhouette).
 #define CULL_COS -0.25f

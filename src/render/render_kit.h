@@ -1,10 +1,19 @@
-// render_internal.h — what the renderer's stage files share: the renderer object, the per-frame state
-// (camera, lights, LOD), lazily compiled programs, targets, and the diffusion level plan.
-// Not public API: render.h is. One file per stage of the paper's Fig. 2:
-//   render_shadow.c (1), render_visibility.c (2), render_attribute.c (3), render_diffusion.c (4),
-//   render_composite.c (5); render_pick.c is the ID buffer; render.c the object, camera and frame.
-#ifndef RS_RENDER_INTERNAL_H
-#define RS_RENDER_INTERNAL_H
+// render_kit.h — the renderer's layer below its stages (STYLE.md rule 15): the state every part shares
+// and the toolbox the stages draw with. Not public API: render.h is.
+//   Layers, each calling only the ones below it (tests/test_layering.sh checks the objects):
+//     render.c            the orchestrator: the renderer object, targets, the frame (stages in order)
+//     render_stages.h     the stages of the paper's Fig. 2, one file each: render_shadow.c (1),
+//                         render_visibility.c (2), render_attribute.c (3), render_diffusion.c (4),
+//                         render_composite.c (5); beside them render_pick.c (the ID buffer),
+//                         render_env.c (the environment), render_fine.c (the fine makeup layer)
+//     render_kit.h        this: render_view.c (camera, frame parameters, dirty rectangle) and
+//                         render_kit.c (programs, textures, FBO check, splat drawing)
+// struct rs_renderer is defined here, below the stages, not in render.c: it is the state they all share
+// (each stage reads the splat buffers and the frame targets and keeps its own cache in it: shadow maps,
+// ID buffer, environment, fine layer, diffusion levels), so no one layer owns it. render.c creates and
+// destroys it and calls each stage's release; its own fields are the targets and the incremental frame.
+#ifndef RS_RENDER_KIT_H
+#define RS_RENDER_KIT_H
 
 #include "formats/env.h"
 #include "render/profile.h"
@@ -104,7 +113,7 @@ typedef struct rs_diffusion_level {
 // Level targets exist at full, half and quarter resolution (rs_diffusion_level.res_div 1, 2, 4).
 #define RS_LEVEL_DIVS 3
 
-// The mobile pipeline's defaults (render.c, render_diffusion.c; docs/mobile.md has the measurements).
+// The mobile pipeline's defaults (render_view.c, render_diffusion.c; docs/mobile.md has the measurements).
 // Main passes: the LOD prefix nearest (in log) to this many visible splats per pixel of the face's screen
 // area (at 512x512 and the default framing: the 145k prefix of the 600k head, ~1.3 drawn splats per face
 // pixel), but never more than RS_MOBILE_MAX_LOD_STEPS LOD levels (each ~2x) below the max_splats cap:
@@ -140,7 +149,7 @@ typedef struct rs_frame {
     uint32_t count;          // splats in the main passes (an LOD prefix)
     float radius_scale;      // reference: rs_splat_lod_radius_scale(count); mobile: see RS_MOBILE_COVER
     bool mobile;             // RS_PIPELINE_MOBILE
-    float face_px;           // mobile: estimated screen area of the face, pixels (render.c face_pixels)
+    float face_px;           // mobile: estimated screen area of the face, pixels (render_view.c face_pixels)
     int shadow_slot;         // which of the renderer's shadow maps (0 reference, 1 mobile)
     bool quads;              // main passes drawn as instanced quads
     float eps;               // visibility push along the view ray, model units
@@ -182,7 +191,7 @@ struct rs_renderer {
 
     // Shadow maps (reference, mobile), re-rendered only when the light or the LOD changes.
     rs_shadow_map shadow[2];
-    float area_total;           // the cloud's surface area, model units^2 (render.c face_pixels)
+    float area_total;           // the cloud's surface area, model units^2 (render_view.c face_pixels)
 
     // ID buffer, re-rendered only when the view changes.
     int pw, ph;
@@ -216,44 +225,23 @@ struct rs_renderer {
     rs_render_stats stats;
 };
 
-// render.c
+// render_view.c
 void rs_render_frame_setup(const rs_renderer *r, const rs_view *view, rs_frame *f);
 void rs_render_camera(const rs_renderer *r, const rs_view *view, rs_camera *cam);
+// Quads when a sphere of radius `radius` (model units) at the nearest depth outgrows point sprites.
+bool rs_render_needs_quads(const rs_renderer *r, const rs_frame *f, float radius);
+// Grows the incremental frame's dirty rectangle by a model-space sphere's screen footprint.
+void rs_render_mark_dirty_sphere(rs_renderer *r, const float pos[3], float radius);
+
+// render_kit.c
 rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *out, rs_error *err);
 // Uniforms every splat program shares: transform, sprite placement, LOD radius, culling.
 void rs_render_splat_uniforms(GLuint prog, const mat4 view, const mat4 proj, const mat4 inv_proj, int w, int h,
                               bool persp, float radius_scale, float cull_cos, float point_max);
 void rs_render_draw_splats(const rs_renderer *r, uint32_t count, bool quads);
-// Quads when a sphere of radius `radius` (model units) at the nearest depth outgrows point sprites.
-bool rs_render_needs_quads(const rs_renderer *r, const rs_frame *f, float radius);
 rs_result rs_render_fbo_check(const char *what, rs_error *err);
 GLuint rs_render_texture(GLenum internal_format, int w, int h);
 void rs_render_bind_texture(int unit, GLuint tex);
-// Sets the shadow_lookup.glsl uniforms for the frame.
-void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
-
-// The stages.
-rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err);
-rs_result rs_render_visibility(rs_renderer *r, const rs_frame *f, rs_error *err);
-rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err);
-// Fills levels[] for the frame's pipeline and returns their number; delta_weight gets the summed RGB
-// weights of the Gaussians too narrow to draw (the composite adds them as per-pixel irradiance).
-int rs_render_diffusion_plan(rs_renderer *r, const rs_frame *f, rs_diffusion_level levels[RS_PROFILE_MAX],
-                             float delta_weight[3]);
-rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
-                              rs_error *err);
-rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err);
-void rs_render_pick_release(rs_renderer *r);
-// render_env.c: the env_light.glsl uniforms and textures for the frame.
-void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
-void rs_render_env_release(rs_renderer *r);
-void rs_render_shadow_release(rs_renderer *r);
-void rs_render_level_release(rs_renderer *r);
-// render_fine.c: the fine layer's uniforms and textures for the composite; its GL objects.
-void rs_render_fine_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
-void rs_render_fine_release(rs_renderer *r);
-// render.c: grows the incremental frame's dirty rectangle by a model-space sphere's screen footprint.
-void rs_render_mark_dirty_sphere(rs_renderer *r, const float pos[3], float radius);
 
 static inline GLint rs_uloc(GLuint prog, const char *name) { return glGetUniformLocation(prog, name); }
 
