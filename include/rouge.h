@@ -15,7 +15,8 @@
 //     pixel-store settings and an sRGB framebuffer (it writes so the picture is encoded once) do not
 //     change what it draws or reads;
 //   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
-//     through an ID buffer, one- and two-finger navigation; brush, eraser, mirror, undo / redo / clear;
+//     through an ID buffer, one- and two-finger navigation; brush, eraser, smudge and blend tools,
+//     mirror, undo / redo / clear;
 //   - save and load looks (the makeup) as files or memory, list the products in one (look_info), show a
 //     second look beside the painted one;
 //     custom products (colour, finish, coverage) on the brush; record and replay stroke files;
@@ -387,6 +388,22 @@ typedef enum rouge_finish {
     ROUGE_FINISH_SHIMMER,        // pigment-tinted flakes that glint (highlighter)
 } rouge_finish;
 
+// What a brush does with the makeup. DOES: smudge drags the product already on the face along the stroke
+// (what lies under the first stamp is picked up, laid down where the brush moves wherever it is stronger
+// than what is there, and mixed with what the brush passes over, so it fades along the drag: a higher
+// opacity carries it further); blend evens the makeup in place (each stamp lays its footprint's average
+// into the weaker part: a hard edge becomes a soft ramp, an even area stays). Both sample the whole
+// makeup (every product, both resolutions) on the face's own side (a mirrored stroke samples its
+// mirror side there), ignore the region mask and the cosmetic (the cosmetic only gives the default
+// size), and are recorded in stroke files and saved in looks like any painting (undo: one stroke).
+// DOES NOT: thin or remove product (a stroke only adds: smudging bare skin into a lipstick leaves it,
+// blending a hard edge feathers it outwards); use the eraser (eraser with a tool is ROUGE_ERR_ARG).
+typedef enum rouge_tool {
+    ROUGE_TOOL_PAINT = 0,        // lay the brush's product down (or erase, with eraser)
+    ROUGE_TOOL_SMUDGE,           // drag the makeup under the brush along the stroke
+    ROUGE_TOOL_BLEND,            // soften edges in place
+} rouge_tool;
+
 typedef struct rouge_brush {
     const char *cosmetic;        // a preset name (rouge_cosmetic_get); NULL = "foundation_1"
     // A custom product made from the preset (it keeps the preset's kind, region and brush; looks record it
@@ -405,6 +422,8 @@ typedef struct rouge_brush {
     // products unmasked. A brush narrower than 4 mm (liner, brow pencil, mascara at their sizes) is
     // drawn per pixel exactly where it is painted and is not masked: a pencil is its own mask.
     bool any_region;
+    // 0 = paint. With smudge or blend, opacity is the tool's strength (0 = 0.8) and size its size.
+    rouge_tool tool;
 } rouge_brush;
 
 typedef struct rouge_cosmetic {

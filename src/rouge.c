@@ -1238,11 +1238,18 @@ rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge
     if (!(b.size >= 0 && b.size <= 2) || !(b.opacity >= 0 && b.opacity <= 1))
         return fail_arg(err, "brush: size must be 0..2 (face heights), opacity 0..1");
     if ((unsigned)b.finish > ROUGE_FINISH_SHIMMER) return fail_arg(err, "brush: unknown finish");
+    if ((unsigned)b.tool > ROUGE_TOOL_BLEND) {
+        rs_error e = {0};
+        rs_fail(&e, RS_ERR_ARG, "brush: unknown tool %d (0 paint, 1 smudge, 2 blend)", (int)b.tool);
+        return fail_out(err, &e);
+    }
+    if (b.tool != ROUGE_TOOL_PAINT && b.eraser)
+        return fail_arg(err, "brush: eraser and a smudge or blend tool at once (the eraser is a paint tool)");
     if (!(b.coverage <= 1) || !(b.color[3] >= 0) || !isfinite(b.color[0] + b.color[1] + b.color[2]))
         return fail_arg(err, "brush: coverage must be <= 1, the colour finite with alpha >= 0");
     rs_paint_brush pb = {.cosmetic = *c, .size_rel = b.size, .opacity = b.opacity,
                          .pressure = (rs_makeup_pressure)b.pressure, .eraser = b.eraser, .mirror = b.mirror,
-                         .any_region = b.any_region};
+                         .any_region = b.any_region, .tool = (rs_paint_tool)b.tool};
     if (b.color[3] > 0 || b.finish != ROUGE_FINISH_DEFAULT || b.coverage != 0) {
         // A custom product of the preset's kind: a recoloured lipstick still belongs on the lips.
         rs_cosmetic *pc = &pb.cosmetic;

@@ -841,6 +841,8 @@ const rs_makeup_gpu *rs_makeup_records(const rs_makeup *mk) { return mk->rec; }
 const uint8_t *rs_makeup_touches(const rs_makeup *mk) { return mk->touch; }
 void rs_makeup_get_uniforms(const rs_makeup *mk, rs_makeup_uniforms *out) { *out = mk->uni; }
 
+static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
+
 // --- gathering -------------------------------------------------------------------------------------
 
 typedef struct cell_box {
@@ -918,6 +920,32 @@ bool rs_makeup_nearest(const rs_makeup *mk, const float pos[3], float max_dist, 
     if (x.best == UINT32_MAX) return false;
     *idx = x.best;
     return true;
+}
+
+typedef struct near_ctx {
+    const rs_makeup *mk;
+    const float *p;
+    float r2;
+    rs_makeup_near_fn fn;
+    void *user;
+} near_ctx;
+
+static bool near_cell(void *user, const grid_cell *gc)
+{
+    near_ctx *x = user;
+    for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
+        uint32_t i = x->mk->order[k];
+        float d2 = dist2(x->mk->cloud->pos[i], x->p);
+        if (d2 < x->r2 && !x->fn(x->user, i, d2)) return false;
+    }
+    return true;
+}
+
+void rs_makeup_for_each_near(const rs_makeup *mk, const float pos[3], float radius, rs_makeup_near_fn fn, void *user)
+{
+    if (!(radius > 0.0f) || !finite3(pos)) return;
+    near_ctx x = {mk, pos, radius * radius, fn, user};
+    for_cells(mk, pos, radius, near_cell, &x, NULL);
 }
 
 static uint32_t sum_cell_counts(const rs_makeup *mk, const float p[3], float r)
@@ -1094,7 +1122,6 @@ static int log_cosmetic(rs_makeup *mk, const rs_cosmetic *c)
     return (int)mk->cosmetic_count++;
 }
 
-static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
 static void apply_stamp(rs_makeup *mk, const rs_makeup_applied *s, const rs_cosmetic *cosmetic,
                         const uint8_t *mask, rs_makeup_stamp_info *info)
