@@ -55,6 +55,7 @@ const vw_shortcut vw_shortcuts[] = {
     {"1-9, Tab", "pick a cosmetic; Tab: next"},
     {"[ ], Shift+[ ]", "brush size, opacity"},
     {"E, M", "eraser, mirror painting"},
+    {"J, Shift+J", "smudge, blend the makeup on the face"},
     {"K", "keep the brush to its region"},
     {"C", "product editor: colour, finish, coverage"},
     {"V (in the editor)", "eyedropper: the face's colour under the pointer"},
@@ -159,8 +160,9 @@ void vw_apply_brush(vw_viewer *v)
     if (!v->face) return;
     // The product as the public brush: the preset, and what the editor changed about it.
     const rs_cosmetic *c = vw_current_cosmetic(v), *preset = rs_cosmetic_get((uint32_t)v->cosmetic);
-    rouge_brush b = {.cosmetic = preset->name, .size = v->size_rel, .opacity = v->opacity, .eraser = v->eraser,
-                     .mirror = v->mirror, .any_region = v->any_region};
+    rouge_brush b = {.cosmetic = preset->name, .size = v->size_rel, .opacity = v->opacity,
+                     .eraser = v->eraser && v->tool == ROUGE_TOOL_PAINT, .mirror = v->mirror,
+                     .any_region = v->any_region, .tool = v->tool};
     if (v->editor.custom) {
         if (memcmp(c->rgb, preset->rgb, 3) != 0)
             for (int i = 0; i < 3; i++) b.color[i] = c->rgb[i] / 255.0f, b.color[3] = 1;
@@ -191,6 +193,19 @@ static void toggle_region(vw_viewer *v)
     else vw_toast(v, false, "Brush paints anywhere (K: keep to the product's region)");
 }
 
+// J / Shift+J and the rail's button: the smudge or blend tool on, or (the same again) back to the product.
+static void toggle_tool(vw_viewer *v, rouge_tool t)
+{
+    v->tool = v->tool == t ? ROUGE_TOOL_PAINT : t;
+    v->eraser = false;
+    v->paint_mode = true;
+    vw_apply_brush(v);
+    if (v->tool == ROUGE_TOOL_SMUDGE)
+        vw_toast(v, false, "Smudge: drag from the makeup to carry it along (opacity: how far)");
+    else if (v->tool == ROUGE_TOOL_BLEND)
+        vw_toast(v, false, "Blend: brush over an edge to soften it");
+}
+
 static void select_cosmetic(vw_viewer *v, int i)
 {
     int n = (int)rs_cosmetic_count();
@@ -202,6 +217,7 @@ static void select_cosmetic(vw_viewer *v, int i)
     v->size_rel = RS_CLAMP(c->size_rel, SIZE_MIN_REL, SIZE_MAX_REL);
     v->opacity = c->opacity;
     v->eraser = false;
+    v->tool = ROUGE_TOOL_PAINT;
     v->paint_mode = true;
     vw_apply_brush(v);
 }
@@ -565,7 +581,8 @@ static void key_action(vw_viewer *v, int key, int mods)
     switch (key) {
     case GLFW_KEY_C: vw_editor_toggle(v); break;
     case GLFW_KEY_P: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
-    case GLFW_KEY_E: v->eraser = !v->eraser, v->paint_mode = true, vw_apply_brush(v); break;
+    case GLFW_KEY_E: v->eraser = !v->eraser, v->tool = ROUGE_TOOL_PAINT, v->paint_mode = true, vw_apply_brush(v); break;
+    case GLFW_KEY_J: toggle_tool(v, shift ? ROUGE_TOOL_BLEND : ROUGE_TOOL_SMUDGE); break;
     case GLFW_KEY_M: v->mirror = !v->mirror, vw_apply_brush(v); break;
     case GLFW_KEY_K: toggle_region(v); break;
     case GLFW_KEY_Z: if (ctrl) do_undo(v, shift); break;
@@ -924,7 +941,12 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
 {
     switch (t) {
     case RS_UI_TOOL_PAINT: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
-    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->paint_mode = true, vw_apply_brush(v); break;
+    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->tool = ROUGE_TOOL_PAINT, v->paint_mode = true, vw_apply_brush(v); break;
+    case RS_UI_TOOL_SMUDGE:  // cycles: off, smudge, blend, off
+        toggle_tool(v, v->tool == ROUGE_TOOL_SMUDGE ? ROUGE_TOOL_BLEND
+                       : v->tool == ROUGE_TOOL_BLEND ? ROUGE_TOOL_BLEND
+                                                     : ROUGE_TOOL_SMUDGE);
+        break;
     case RS_UI_TOOL_MIRROR: v->mirror = !v->mirror, vw_apply_brush(v); break;
     case RS_UI_TOOL_REGION: toggle_region(v); break;
     case RS_UI_TOOL_UNDO: do_undo(v, false); break;

@@ -273,6 +273,7 @@ typedef struct vw_viewer {
     int cosmetic;  // preset index
     float size_rel, opacity;
     bool eraser, mirror;
+    rouge_tool tool;  // J: smudge, Shift+J: blend (ROUGE_TOOL_PAINT: the product or the eraser)
     bool any_region;  // K: paint anywhere instead of keeping to the product's region
 
     // Pointer. Gestures are measured in window coordinates (wx, wy: the events' own), so a render scale
