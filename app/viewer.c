@@ -469,15 +469,45 @@ static void face_close(vw_viewer *v)
 
 // Makes a face from the loader's stream the face on screen: a preview of the LOD levels so far, or the
 // whole face. On failure the previous face stays.
+static void update_window_size(vw_viewer *v);
+static void apply_rung(vw_viewer *v, vw_rung q);
+
+// rouge_face_create's progress while a face is made (seconds: shaders, shadow map, the first frame): the
+// loading screen, drawn and shown at each stage. Closing the window cancels.
+static bool make_progress(void *user, const rouge_progress *p)
+{
+    vw_viewer *v = user;
+    v->load.made = *p;
+    glfwPollEvents();  // input goes to the queue; the window stays responsive
+    update_window_size(v);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, v->fb_w, v->fb_h);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    if (v->face) {  // a preview stays on screen while the whole face is made
+        rs_ui_begin(v->scene_ui, v->fb_w, v->fb_h, v->ui_scale, &(rs_ui_input){.x = -1, .y = -1});
+        vw_draw_picture(v, v->scene_ui);
+        rs_ui_end(v->scene_ui);
+    }
+    vw_draw_loading_frame(v);
+    glfwSwapBuffers(v->win);
+    return !glfwWindowShouldClose(v->win);
+}
+
+// Makes the face of the stream, with its first frame (at the full-quality view the next frame asks for,
+// so that frame only copies it out) shown stage by stage on the loading screen.
 static rs_result face_open(vw_viewer *v, rs_error *err)
 {
     rouge_face *f = NULL;
     rouge_error e = {0};
+    apply_rung(v, (vw_rung){v->cli->view.max_splats, 1.0f});
     v->view.env = v->env_name;
     rouge_result r = rouge_face_create(&(rouge_face_desc){.stream = v->load.stream, .view = &v->view,
                                                           .env_dir = v->env_dir[0] ? v->env_dir : NULL,
-                                                          .manual_navigation = true},
+                                                          .manual_navigation = true, .first_frame = true,
+                                                          .progress_stage = make_progress, .progress_user = v},
                                        &f, &e);
+    v->load.made.stage = NULL;
     if (!r && v->cli->record) r = rouge_face_record_strokes(f, v->cli->record, &e);
     if (r) {
         rouge_face_destroy(f);
@@ -1003,10 +1033,9 @@ static double frame(vw_viewer *v, const vw_script_step *step, rs_error *err)
     double t0 = vw_now();
     v->rendered_this_frame = false;
     update_window_size(v);
-    // A face just made: its first picture takes seconds on a slow GPU (600k splats on a software
-    // rasteriser: ~3 s), so this frame only says so and the next one draws it. Until the face is there
-    // and drawn, input waits in the queue (nothing to act on yet; nothing is lost).
-    if (v->face && !v->drawing_first) {
+    // A face's first picture is made with the face (face_open: seconds on a slow GPU, shown stage by stage
+    // on the loading screen); until the face is there, input waits in the queue (nothing is lost).
+    if (v->face) {
         dispatch(v);
         rs_result r = render_scene(v, err);
         if (r) {
@@ -1032,7 +1061,6 @@ static double frame(vw_viewer *v, const vw_script_step *step, rs_error *err)
     if (step && step->screenshot) vw_write_png(v, step->screenshot, step->rect);
     if (step && step->state) write_state(v, step->state);
     glfwSwapBuffers(v->win);
-    v->drawing_first = false;
     v->frame_no++;
     // The script's `slow`: a slow device, to prove that input keeps arriving whole meanwhile.
     double slow_s = v->have_script ? v->script.slow_s : 0, left_s = t0 + slow_s - vw_now();
@@ -1056,12 +1084,14 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
         (!l->shown || now - l->last_preview >= VW_PREVIEW_EVERY_S)) {
         rouge_stream_progress p = rouge_stream_get_progress(l->stream);
         rs_error e = {0};
-        if (p.ready > l->shown && !p.complete && face_open(v, &e) == RS_OK) {
-            if (!v->partial) reset_camera(v);
-            // The last bytes may have arrived meanwhile: then this face is the whole one.
-            l->shown = v->info.splats, l->last_preview = now;
-            v->partial = l->shown < p.splats;
-            vw_apply_brush(v);
+        if (p.ready > l->shown && !p.complete) {
+            if (!v->partial) reset_camera(v);  // first: the face's first frame is made with the camera
+            if (face_open(v, &e) == RS_OK) {
+                // The last bytes may have arrived meanwhile: then this face is the whole one.
+                l->shown = v->info.splats, l->last_preview = now;
+                v->partial = l->shown < p.splats;
+                vw_apply_brush(v);
+            }
         }
     }
     if (!l->building) {
@@ -1079,8 +1109,9 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
     rs_error e = {0};
     rs_result r = (rs_result)l->result;
     if (r) rs_fail(&e, r, "%s", l->err.msg);
-    else if (!l->shown || was_partial) r = face_open(v, &e);
-    v->drawing_first = !r && (!l->shown || was_partial);
+    // The camera first, so the face's first frame (made with it) is the one shown.
+    if (!r && !l->shown) reset_camera(v);
+    if (!r && (!l->shown || was_partial)) r = face_open(v, &e);
     rouge_stream_destroy(l->stream);
     l->stream = NULL;
     v->partial = false;  // on failure a preview stays: all there is of that file
@@ -1090,7 +1121,6 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
         vw_toast(v, true, "%s", e.msg);
         return RS_OK;
     }
-    if (!l->shown) reset_camera(v);  // a preview of this file set the camera already
     if (l->initial && v->cli->look) {
         if ((r = vw_load_look_file(v, v->cli->look, err))) return r;
         vw_toast(v, false, "Loaded look %s", v->cli->look);

@@ -237,6 +237,15 @@ const char *rouge_environment_name(int i);
 typedef struct rouge_face rouge_face;
 typedef struct rouge_stream rouge_stream;
 
+// Where a rouge_face_create stands (rouge_face_desc.progress_stage).
+typedef struct rouge_progress {
+    float fraction;              // as rouge_face_desc.progress has it: 0..1, never decreasing
+    const char *stage;           // what runs from now (static): "reading the face", "uploading and compiling",
+                                 // "makeup layer", "lighting", then with first_frame "shadow map",
+                                 // "visibility", "attributes", "light and diffusion", "composite"; "done" last
+    int step, steps;             // this stage's number (1-based) and how many there are; step == steps: done
+} rouge_progress;
+
 typedef struct rouge_face_desc {
     const char *path;            // a .rsf file; or
     const void *data;            // the bytes of one (not kept after create); or
@@ -255,9 +264,21 @@ typedef struct rouge_face_desc {
     // start, then after each stage (the splats parsed and decoded, uploaded with the shaders compiled,
     // the makeup layer made, the environment uploaded), 1 last; never decreasing. Returning false cancels:
     // create frees what it made and returns ROUGE_ERR_CANCELLED ("cancelled"), *out untouched. It must not
-    // call rouge on this face (there is none yet).
+    // call rouge on this face (there is none yet). It may draw in the creating context (a loading
+    // screen, then swap buffers): your GL state is in place during the call, rouge's is put back after.
     bool (*progress)(void *user, float fraction);
-    void *progress_user;         // handed to progress
+    void *progress_user;         // handed to progress and progress_stage
+    // Also render the view's first frame before returning (as rouge_face_render would: into the face's
+    // texture, at the view's size, 0 = 512 x 512). Its stages compile their shaders on first use and make
+    // the shadow map and the light, seconds for a large face on a software GPU: inside create they are
+    // reported (and may be cancelled) like the rest, and the host's first render or draw of that view at
+    // that size only copies the frame out. The fractions are then about shares of the time: create's own
+    // stages take 0..0.1, the frame 0.1..1.
+    bool first_frame;
+    // Called (when not NULL) with progress, at the same moments, with the stage about to run by name and
+    // number (rouge_progress), e.g. for "Compiling: shadow map (5 of 10)". Returning false cancels, as
+    // progress. The same rules.
+    bool (*progress_stage)(void *user, const rouge_progress *p);
 } rouge_face_desc;
 
 // Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
