@@ -477,7 +477,12 @@ static void apply_rung(vw_viewer *v, vw_rung q);
 static bool make_progress(void *user, const rouge_progress *p)
 {
     vw_viewer *v = user;
-    v->load.made = *p;
+    vw_loader *l = &v->load;
+    l->made = *p;
+    if (p->step == 1) l->screens = 0, l->screens_log[0] = '\0';
+    size_t n = strlen(l->screens_log);
+    snprintf(l->screens_log + n, sizeof l->screens_log - n, "%s@%.3f;", p->stage, p->fraction);
+    l->screens++;
     glfwPollEvents();  // input goes to the queue; the window stays responsive
     update_window_size(v);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -1020,6 +1025,7 @@ static void write_state(vw_viewer *v, const char *path)
             v->view.pitch_deg, v->view.zoom, v->view.pan[0], v->view.pan[1], v->light_dial[0], v->light_dial[1]);
     fprintf(f, "editor_open %d\neditor_hsv %.3f %.4f %.4f\neditor_rgb %d %d %d\nshades %d\n", e->open, e->hsv[0],
             e->hsv[1], e->hsv[2], e->product.rgb[0], e->product.rgb[1], e->product.rgb[2], e->shade_count);
+    fprintf(f, "loading_screens %d\nloading_stages %s\n", v->load.screens, v->load.screens_log);
     fprintf(f, "render_scale %.3f\nrender_scale_range %.3f %.3f\n", v->render_scale, v->scale_lo, v->scale_hi);
     fprintf(f, "looks_sheet %d\nsave_dialog %d\nsave_name %s\nsplit %d\nsplit_left %s\ntoast %s\n", v->looks.open,
             v->looks.saving, v->looks.name, v->split, v->looks.compare[0] ? v->looks.compare : "(bare)", v->toast);

@@ -176,6 +176,8 @@ typedef struct vw_loader {
     double decoded_s;             // ... how long reading and decoding took
     rouge_progress made;          // while the face is made (rouge_face_create, its first frame included):
                                   // the stage it reports (stage NULL otherwise)
+    int screens;                  // loading screens drawn between those stages (the script's `state`) ...
+    char screens_log[480];        // ... as "stage@fraction;" (the last face's)
 } vw_loader;
 
 // The look library (viewer_looks.c).

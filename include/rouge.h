@@ -295,7 +295,8 @@ typedef struct rouge_stream_progress {
     uint32_t splats;             // the face's splat count once the header has arrived, else 0
     uint32_t decoded;            // splats decoded and checked
     uint32_t ready;              // splats a preview would show (a LOD prefix), 0 while none
-    bool complete;               // every byte has arrived: a face from the stream is the whole face
+    bool complete;               // every byte has arrived: a face from the stream is the whole face (and
+                                 // stays true, with the counts, once a face took the splats)
 } rouge_stream_progress;
 
 // `name` names the stream in messages (NULL = "(stream)"); total_bytes is the file's size when known

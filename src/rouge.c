@@ -193,6 +193,7 @@ struct rouge_stream {
     rs_splat_loader *ld;
     uint64_t bytes;
     bool taken;                   // a complete stream's splats went to a face
+    rouge_stream_progress final;  // its progress then: the loader forgets it, the reading thread must not
 };
 
 static rouge_result fail_out(rouge_error *out, const rs_error *e)
@@ -271,14 +272,20 @@ rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, r
     return r ? fail_out(err, &e) : ROUGE_OK;
 }
 
+static rouge_stream_progress stream_progress(rouge_stream *s)
+{
+    if (s->taken) return s->final;
+    const rs_splat_header *h = rs_splat_loader_header(s->ld);
+    return (rouge_stream_progress){.bytes = s->bytes, .splats = h ? h->count : 0,
+                                   .decoded = rs_splat_loader_decoded(s->ld), .ready = rs_splat_loader_ready(s->ld),
+                                   .complete = rs_splat_loader_complete(s->ld)};
+}
+
 rouge_stream_progress rouge_stream_get_progress(rouge_stream *s)
 {
     if (!s) return (rouge_stream_progress){0};
     pthread_mutex_lock(&s->mu);
-    const rs_splat_header *h = rs_splat_loader_header(s->ld);
-    rouge_stream_progress p = {.bytes = s->bytes, .splats = h ? h->count : 0,
-                               .decoded = rs_splat_loader_decoded(s->ld), .ready = rs_splat_loader_ready(s->ld),
-                               .complete = rs_splat_loader_complete(s->ld)};
+    rouge_stream_progress p = stream_progress(s);
     pthread_mutex_unlock(&s->mu);
     return p;
 }
@@ -300,8 +307,12 @@ static rs_result stream_cloud(rouge_stream *s, rs_splat_cloud **out, rs_error *e
     if (s->taken) {
         r = rs_fail(e, RS_ERR_ARG, "stream: its splats already went to a face");
     } else if (rs_splat_loader_complete(s->ld)) {
+        // Still complete after the hand-over: a reading thread that checks between its last bytes and
+        // its exit must not take the stream for a truncated one.
+        rouge_stream_progress p = stream_progress(s);
         r = rs_splat_loader_finish(s->ld, out, e);
         s->taken = r == RS_OK;
+        s->final = p;
     } else {
         uint32_t ready = rs_splat_loader_ready(s->ld);
         r = ready ? rs_splat_loader_preview(s->ld, ready, out, e)

@@ -180,6 +180,32 @@ static void test_cancel_at_a_frame_stage(void)
     rouge_face_destroy(f);
 }
 
+// A stream's progress stays complete once a face took its splats: the viewer's reading thread checks it
+// after its last bytes, and once took a face made meanwhile for a truncated file.
+static void test_stream_stays_complete_after_the_hand_over(void)
+{
+    FILE *fp = fopen(FACE_PATH, "rb");
+    RS_REQUIRE(fp, "open %s", FACE_PATH);
+    static uint8_t buf[1 << 16];
+    rouge_stream *st = NULL;
+    rouge_error e = {0};
+    RS_REQUIRE(rouge_stream_create("face", 0, &st, &e) == ROUGE_OK, "stream: %s", e.msg);
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, fp)) > 0) rouge_stream_feed(st, buf, n, &e);
+    fclose(fp);
+    rouge_stream_progress before = rouge_stream_get_progress(st);
+    rouge_face *f = NULL;
+    RS_REQUIRE(rouge_face_create(&(rouge_face_desc){.stream = st, .env_dir = "assets/env"}, &f, &e) == ROUGE_OK,
+               "create: %s", e.msg);
+    rouge_stream_progress after = rouge_stream_get_progress(st);
+    RS_CHECK(before.complete && after.complete && after.splats == before.splats && after.bytes == before.bytes &&
+                 after.decoded == before.decoded,
+             "after the hand-over: complete %d, %u splats, %u decoded (before: %d, %u, %u)", after.complete,
+             after.splats, after.decoded, before.complete, before.splats, before.decoded);
+    rouge_face_destroy(f);
+    rouge_stream_destroy(st);
+}
+
 int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
@@ -198,6 +224,7 @@ int main(int argc, char **argv)
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, host_tex, 0);
     RS_RUN(test_first_frame_stages_are_reported_in_order);
     RS_RUN(test_cancel_at_a_frame_stage);
+    RS_RUN(test_stream_stays_complete_after_the_hand_over);
     glDeleteFramebuffers(1, &host_fbo);
     glDeleteTextures(1, &host_tex);
     rs_gl_destroy(gl);
