@@ -550,8 +550,8 @@ function syncControls() {
     pressed($('#smudge'), ui.tool === 'smudge');
     pressed($('#blend'), ui.tool === 'blend');
     pressed($('#mirror'), ui.mirror);
-    pressed($('#region'), !ui.anyRegion && !!p.region);
-    $('#region').disabled = !p.region;
+    pressed($('#region'), !ui.anyRegion && !!p.region && ui.tool === 'paint');
+    $('#region').disabled = !p.region || ui.tool !== 'paint';  // smudge and blend keep to no region
     $('#region span').textContent = p.region ? `${pretty(p.region)} only` : 'Anywhere';
     pressed($('#before'), ui.hide);
     for (const b of document.querySelectorAll('.swatch')) {
