@@ -201,7 +201,7 @@ static void toggle_tool(vw_viewer *v, rouge_tool t)
     v->paint_mode = true;
     vw_apply_brush(v);
     if (v->tool == ROUGE_TOOL_SMUDGE)
-        vw_toast(v, false, "Smudge: drag from the makeup to carry it along (opacity: how far)");
+        vw_toast(v, false, "Smudge: drag from the makeup to carry it along");
     else if (v->tool == ROUGE_TOOL_BLEND)
         vw_toast(v, false, "Blend: brush over an edge to soften it");
 }
