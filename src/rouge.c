@@ -997,7 +997,8 @@ static rs_result render_first_frame(rouge_face *f, create_progress *p, rs_error 
     rs_result r = gl_save(f, &s, e);
     if (r) return r;
     first_frame_ctx x = {f, p, &s, false};
-    rs_render_set_stage_hook(f->ren, first_frame_stage, &x);
+    // Without callbacks there is nothing to report (and no glFinish between the stages is needed).
+    if (p->d->progress || p->d->progress_stage) rs_render_set_stage_hook(f->ren, first_frame_stage, &x);
     r = render_at(f, f->view.width > 0 ? f->view.width : ROUGE_DEFAULT_SIZE,
                   f->view.height > 0 ? f->view.height : ROUGE_DEFAULT_SIZE, e);
     rs_render_set_stage_hook(f->ren, NULL, NULL);
