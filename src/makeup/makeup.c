@@ -841,8 +841,6 @@ const rs_makeup_gpu *rs_makeup_records(const rs_makeup *mk) { return mk->rec; }
 const uint8_t *rs_makeup_touches(const rs_makeup *mk) { return mk->touch; }
 void rs_makeup_get_uniforms(const rs_makeup *mk, rs_makeup_uniforms *out) { *out = mk->uni; }
 
-static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
-
 // --- gathering -------------------------------------------------------------------------------------
 
 typedef struct cell_box {
@@ -943,7 +941,7 @@ static bool near_cell(void *user, const grid_cell *gc)
 
 void rs_makeup_for_each_near(const rs_makeup *mk, const float pos[3], float radius, rs_makeup_near_fn fn, void *user)
 {
-    if (!(radius > 0.0f) || !finite3(pos)) return;
+    if (!(radius > 0.0f) || !isfinite(pos[0] + pos[1] + pos[2])) return;
     near_ctx x = {mk, pos, radius * radius, fn, user};
     for_cells(mk, pos, radius, near_cell, &x, NULL);
 }
@@ -1122,6 +1120,8 @@ static int log_cosmetic(rs_makeup *mk, const rs_cosmetic *c)
     return (int)mk->cosmetic_count++;
 }
 
+
+static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 
 static void apply_stamp(rs_makeup *mk, const rs_makeup_applied *s, const rs_cosmetic *cosmetic,
                         const uint8_t *mask, rs_makeup_stamp_info *info)
