@@ -497,6 +497,15 @@ void rs_ui_icon_draw(rs_ui *ui, rs_ui_icon icon, rs_ui_rect r, rs_ui_rgba c)
         for (int i = 0; i < 8; i++) A(&p, 12, 12, 8.5f, (float)i * 45.0f + 8.0f, (float)i * 45.0f + 30.0f);
         D(&p, 12, 12, 4.0f);
         break;
+    case RS_UI_ICON_SMUDGE:  // a fingertip pressed down at the upper right, its smear fading to the lower left
+        A(&p, 16.5f, 7.5f, 3.8f, 0, 360);
+        L(&p, 13.8f, 10.2f, 4, 20), L(&p, 16.5f, 11.3f, 9, 20.5f), L(&p, 12.7f, 7.5f, 5, 13.5f);
+        break;
+    case RS_UI_ICON_BLEND:  // a round brush head over a line that turns from solid to dotted
+        D(&p, 12, 8, 4.5f);
+        L(&p, 12, 12.5f, 12, 14.5f);
+        L(&p, 3, 19, 10, 19), D(&p, 13, 19, 1.1f), D(&p, 16.5f, 19, 0.8f), D(&p, 20, 19, 0.5f);
+        break;
     case RS_UI_ICON_CLOSE:
         L(&p, 6, 6, 18, 18), L(&p, 18, 6, 6, 18);
         break;

@@ -62,6 +62,8 @@ typedef enum rs_ui_icon {
     RS_UI_ICON_CLOSE,
     RS_UI_ICON_CHEVRONS,  // < > on the split divider
     RS_UI_ICON_REGION,    // the brush keeps to the product's region (a dot inside a dashed outline)
+    RS_UI_ICON_SMUDGE,    // a fingertip and the smear it drags
+    RS_UI_ICON_BLEND,     // a round brush over a hard line turned soft
     RS_UI_ICON_COUNT
 } rs_ui_icon;
 
@@ -147,12 +149,13 @@ rs_ui_rect rs_ui_rect_inset(rs_ui_rect r, float d);
 
 // --- the makeup toolbar ---------------------------------------------------------------------------
 // Everything a person taps. Panels: top bar (render mode, pipeline, split, HUD, save/load, screenshot,
-// help), left rail (paint/view, eraser, mirror, region, undo, redo, clear), right rail (light dial, brush size,
+// help), left rail (paint/view, eraser, smudge/blend, mirror, region, undo, redo, clear), right rail (light dial, brush size,
 // opacity) and bottom sheet (cosmetic swatches with the selected product's name).
 typedef enum rs_ui_tool {
     RS_UI_TOOL_NONE = 0,
     RS_UI_TOOL_PAINT,         // toggles paint / view mode
     RS_UI_TOOL_ERASER,
+    RS_UI_TOOL_SMUDGE,        // the makeup tools: off -> smudge (drag the makeup along) -> blend (soften) -> off
     RS_UI_TOOL_MIRROR,
     RS_UI_TOOL_REGION,        // region-aware brush on/off
     RS_UI_TOOL_UNDO,
@@ -201,6 +204,7 @@ typedef struct rs_ui_toolbar_state {
     float light[2];                        // light dial position in the unit disc (x right, y up); dragging
                                            // the sun moves it by the drag / RS_UI_DIAL_DRAG_PT points
     bool paint, eraser, mirror, keep_region, split, hud, help;
+    bool smudge, blend;                    // the smudge or blend tool is on (the sheet names it)
     bool can_undo, can_redo;
     int mode;                              // 0 albedo, 1 diffuse, 2 full
     bool mobile;                           // pipeline: mobile (true) or reference

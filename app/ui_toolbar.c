@@ -19,8 +19,9 @@
 
 static const rs_ui_tool top_icons[] = {RS_UI_TOOL_SPLIT, RS_UI_TOOL_HUD, RS_UI_TOOL_SAVE,
                                        RS_UI_TOOL_LOAD, RS_UI_TOOL_SCREENSHOT, RS_UI_TOOL_HELP};
-static const rs_ui_tool left_tools[] = {RS_UI_TOOL_PAINT, RS_UI_TOOL_ERASER, RS_UI_TOOL_MIRROR, RS_UI_TOOL_REGION,
-                                        RS_UI_TOOL_UNDO,  RS_UI_TOOL_REDO,   RS_UI_TOOL_CLEAR};
+// One button for smudge and blend (it cycles): two would not fit an 800 x 600 window at full size.
+static const rs_ui_tool left_tools[] = {RS_UI_TOOL_PAINT,  RS_UI_TOOL_ERASER, RS_UI_TOOL_SMUDGE, RS_UI_TOOL_MIRROR,
+                                        RS_UI_TOOL_REGION, RS_UI_TOOL_UNDO,   RS_UI_TOOL_REDO,   RS_UI_TOOL_CLEAR};
 #define LEFT_N ((int)RS_COUNT_OF(left_tools))
 
 void rs_ui_toolbar_layout_compute(int fb_w, int fb_h, float scale, int swatch_count, rs_ui_toolbar_layout *out)
@@ -165,14 +166,18 @@ rs_ui_tool rs_ui_toolbar(rs_ui *ui, const rs_ui_toolbar_layout *l, rs_ui_toolbar
         if (rs_ui_button(ui, (int)(1000 + top_icons[i]), l->tool[top_icons[i]], top_icon[i], top_on[i]))
             hit = top_icons[i];
 
-    // Left rail: paint/view, eraser, mirror, region | undo, redo, clear.
+    // Left rail: paint/view, eraser, smudge/blend, mirror, region | undo, redo, clear.
     rs_ui_panel(ui, l->left, rad);
-    static const rs_ui_icon left_icon[] = {RS_UI_ICON_BRUSH, RS_UI_ICON_ERASER, RS_UI_ICON_MIRROR, RS_UI_ICON_REGION,
-                                           RS_UI_ICON_UNDO,  RS_UI_ICON_REDO,   RS_UI_ICON_TRASH};
-    const bool left_on[] = {st->paint, st->eraser, st->mirror, st->keep_region, false, false, false};
+    static const rs_ui_icon left_icon[] = {RS_UI_ICON_BRUSH,  RS_UI_ICON_ERASER, RS_UI_ICON_SMUDGE, RS_UI_ICON_MIRROR,
+                                           RS_UI_ICON_REGION, RS_UI_ICON_UNDO,   RS_UI_ICON_REDO,   RS_UI_ICON_TRASH};
+    const bool left_on[] = {st->paint,       st->eraser, st->smudge || st->blend, st->mirror,
+                            st->keep_region, false,      false,                   false};
+    _Static_assert(RS_COUNT_OF(left_icon) == RS_COUNT_OF(left_tools), "left rail");
     for (size_t i = 0; i < RS_COUNT_OF(left_tools); i++) {
         rs_ui_tool t = left_tools[i];
-        rs_ui_icon icon = t == RS_UI_TOOL_PAINT && !st->paint ? RS_UI_ICON_MOVE : left_icon[i];
+        rs_ui_icon icon = t == RS_UI_TOOL_PAINT && !st->paint  ? RS_UI_ICON_MOVE
+                          : t == RS_UI_TOOL_SMUDGE && st->blend ? RS_UI_ICON_BLEND
+                                                                : left_icon[i];
         bool tap = rs_ui_button(ui, (int)(1000 + t), l->tool[t], icon, left_on[i]);
         // Undo/redo without history are drawn dimmed and do nothing.
         bool dim = (t == RS_UI_TOOL_UNDO && !st->can_undo) || (t == RS_UI_TOOL_REDO && !st->can_redo);
@@ -201,16 +206,19 @@ rs_ui_tool rs_ui_toolbar(rs_ui *ui, const rs_ui_toolbar_layout *l, rs_ui_toolbar
     rs_ui_panel(ui, l->bottom, rad);
     int n = RS_MIN(st->swatch_count, l->swatch_count);
     for (int i = 0; i < n; i++)
-        if (rs_ui_swatch(ui, 2000 + i, l->swatch[i], st->swatch_rgb[i], i == st->selected && !st->eraser)) {
-            hit = RS_UI_TOOL_SWATCH, st->selected = i, st->eraser = false;
+        if (rs_ui_swatch(ui, 2000 + i, l->swatch[i], st->swatch_rgb[i],
+                         i == st->selected && !st->eraser && !st->smudge && !st->blend)) {
+            hit = RS_UI_TOOL_SWATCH, st->selected = i, st->eraser = st->smudge = st->blend = false;
             if (swatch) *swatch = i;
         }
     // "Lipstick matte - on lips" while the brush keeps to the product's region.
     const char *product = st->eraser ? "Eraser"
+                          : st->smudge ? "Smudge - drags the makeup along"
+                          : st->blend  ? "Blend - softens the makeup's edges"
                           : (st->selected >= 0 && st->selected < n && st->swatch_name) ? st->swatch_name[st->selected]
                                                                                        : "";
     char name[96];
-    if (!st->eraser && st->region_name) snprintf(name, sizeof name, "%s - on %s", product, st->region_name);
+    if (!st->eraser && !st->smudge && !st->blend && st->region_name) snprintf(name, sizeof name, "%s - on %s", product, st->region_name);
     else snprintf(name, sizeof name, "%s", product);
     int ts = RS_MAX(1, (int)floorf(s * 2 + 0.25f));
     float nw = rs_ui_text_width(name, ts);

@@ -55,6 +55,7 @@ const vw_shortcut vw_shortcuts[] = {
     {"1-9, Tab", "pick a cosmetic; Tab: next"},
     {"[ ], Shift+[ ]", "brush size, opacity"},
     {"E, M", "eraser, mirror painting"},
+    {"J, Shift+J", "smudge, blend the makeup on the face"},
     {"K", "keep the brush to its region"},
     {"C", "product editor: colour, finish, coverage"},
     {"V (in the editor)", "eyedropper: the face's colour under the pointer"},
@@ -159,8 +160,9 @@ void vw_apply_brush(vw_viewer *v)
     if (!v->face) return;
     // The product as the public brush: the preset, and what the editor changed about it.
     const rs_cosmetic *c = vw_current_cosmetic(v), *preset = rs_cosmetic_get((uint32_t)v->cosmetic);
-    rouge_brush b = {.cosmetic = preset->name, .size = v->size_rel, .opacity = v->opacity, .eraser = v->eraser,
-                     .mirror = v->mirror, .any_region = v->any_region};
+    rouge_brush b = {.cosmetic = preset->name, .size = v->size_rel, .opacity = v->opacity,
+                     .eraser = v->eraser && v->tool == ROUGE_TOOL_PAINT, .mirror = v->mirror,
+                     .any_region = v->any_region, .tool = v->tool};
     if (v->editor.custom) {
         if (memcmp(c->rgb, preset->rgb, 3) != 0)
             for (int i = 0; i < 3; i++) b.color[i] = c->rgb[i] / 255.0f, b.color[3] = 1;
@@ -191,6 +193,19 @@ static void toggle_region(vw_viewer *v)
     else vw_toast(v, false, "Brush paints anywhere (K: keep to the product's region)");
 }
 
+// J / Shift+J and the rail's button: the smudge or blend tool on, or (the same again) back to the product.
+static void toggle_tool(vw_viewer *v, rouge_tool t)
+{
+    v->tool = v->tool == t ? ROUGE_TOOL_PAINT : t;
+    v->eraser = false;
+    v->paint_mode = true;
+    vw_apply_brush(v);
+    if (v->tool == ROUGE_TOOL_SMUDGE)
+        vw_toast(v, false, "Smudge: drag from the makeup to carry it along");
+    else if (v->tool == ROUGE_TOOL_BLEND)
+        vw_toast(v, false, "Blend: brush over an edge to soften it");
+}
+
 static void select_cosmetic(vw_viewer *v, int i)
 {
     int n = (int)rs_cosmetic_count();
@@ -202,6 +217,7 @@ static void select_cosmetic(vw_viewer *v, int i)
     v->size_rel = RS_CLAMP(c->size_rel, SIZE_MIN_REL, SIZE_MAX_REL);
     v->opacity = c->opacity;
     v->eraser = false;
+    v->tool = ROUGE_TOOL_PAINT;
     v->paint_mode = true;
     vw_apply_brush(v);
 }
@@ -453,15 +469,50 @@ static void face_close(vw_viewer *v)
 
 // Makes a face from the loader's stream the face on screen: a preview of the LOD levels so far, or the
 // whole face. On failure the previous face stays.
+static void update_window_size(vw_viewer *v);
+static void apply_rung(vw_viewer *v, vw_rung q);
+
+// rouge_face_create's progress while a face is made (seconds: shaders, shadow map, the first frame): the
+// loading screen, drawn and shown at each stage. Closing the window cancels.
+static bool make_progress(void *user, const rouge_progress *p)
+{
+    vw_viewer *v = user;
+    vw_loader *l = &v->load;
+    l->made = *p;
+    if (p->step == 1) l->screens = 0, l->screens_log[0] = '\0';
+    size_t n = strlen(l->screens_log);
+    snprintf(l->screens_log + n, sizeof l->screens_log - n, "%s@%.3f;", p->stage, p->fraction);
+    l->screens++;
+    glfwPollEvents();  // input goes to the queue; the window stays responsive
+    update_window_size(v);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glViewport(0, 0, v->fb_w, v->fb_h);
+    glClearColor(0, 0, 0, 1);
+    glClear(GL_COLOR_BUFFER_BIT);
+    if (v->face) {  // a preview stays on screen while the whole face is made
+        rs_ui_begin(v->scene_ui, v->fb_w, v->fb_h, v->ui_scale, &(rs_ui_input){.x = -1, .y = -1});
+        vw_draw_picture(v, v->scene_ui);
+        rs_ui_end(v->scene_ui);
+    }
+    vw_draw_loading_frame(v);
+    glfwSwapBuffers(v->win);
+    return !glfwWindowShouldClose(v->win);
+}
+
+// Makes the face of the stream, with its first frame (at the full-quality view the next frame asks for,
+// so that frame only copies it out) shown stage by stage on the loading screen.
 static rs_result face_open(vw_viewer *v, rs_error *err)
 {
     rouge_face *f = NULL;
     rouge_error e = {0};
+    apply_rung(v, (vw_rung){v->cli->view.max_splats, 1.0f});
     v->view.env = v->env_name;
     rouge_result r = rouge_face_create(&(rouge_face_desc){.stream = v->load.stream, .view = &v->view,
                                                           .env_dir = v->env_dir[0] ? v->env_dir : NULL,
-                                                          .manual_navigation = true},
+                                                          .manual_navigation = true, .first_frame = true,
+                                                          .progress_stage = make_progress, .progress_user = v},
                                        &f, &e);
+    v->load.made.stage = NULL;
     if (!r && v->cli->record) r = rouge_face_record_strokes(f, v->cli->record, &e);
     if (r) {
         rouge_face_destroy(f);
@@ -565,7 +616,8 @@ static void key_action(vw_viewer *v, int key, int mods)
     switch (key) {
     case GLFW_KEY_C: vw_editor_toggle(v); break;
     case GLFW_KEY_P: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
-    case GLFW_KEY_E: v->eraser = !v->eraser, v->paint_mode = true, vw_apply_brush(v); break;
+    case GLFW_KEY_E: v->eraser = !v->eraser, v->tool = ROUGE_TOOL_PAINT, v->paint_mode = true, vw_apply_brush(v); break;
+    case GLFW_KEY_J: toggle_tool(v, shift ? ROUGE_TOOL_BLEND : ROUGE_TOOL_SMUDGE); break;
     case GLFW_KEY_M: v->mirror = !v->mirror, vw_apply_brush(v); break;
     case GLFW_KEY_K: toggle_region(v); break;
     case GLFW_KEY_Z: if (ctrl) do_undo(v, shift); break;
@@ -924,7 +976,12 @@ static void apply_tool(vw_viewer *v, rs_ui_tool t, const rs_ui_toolbar_state *st
 {
     switch (t) {
     case RS_UI_TOOL_PAINT: v->paint_mode = !v->paint_mode, vw_apply_brush(v); break;
-    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->paint_mode = true, vw_apply_brush(v); break;
+    case RS_UI_TOOL_ERASER: v->eraser = !v->eraser, v->tool = ROUGE_TOOL_PAINT, v->paint_mode = true, vw_apply_brush(v); break;
+    case RS_UI_TOOL_SMUDGE:  // cycles: off, smudge, blend, off
+        toggle_tool(v, v->tool == ROUGE_TOOL_SMUDGE ? ROUGE_TOOL_BLEND
+                       : v->tool == ROUGE_TOOL_BLEND ? ROUGE_TOOL_BLEND
+                                                     : ROUGE_TOOL_SMUDGE);
+        break;
     case RS_UI_TOOL_MIRROR: v->mirror = !v->mirror, vw_apply_brush(v); break;
     case RS_UI_TOOL_REGION: toggle_region(v); break;
     case RS_UI_TOOL_UNDO: do_undo(v, false); break;
@@ -968,6 +1025,7 @@ static void write_state(vw_viewer *v, const char *path)
             v->view.pitch_deg, v->view.zoom, v->view.pan[0], v->view.pan[1], v->light_dial[0], v->light_dial[1]);
     fprintf(f, "editor_open %d\neditor_hsv %.3f %.4f %.4f\neditor_rgb %d %d %d\nshades %d\n", e->open, e->hsv[0],
             e->hsv[1], e->hsv[2], e->product.rgb[0], e->product.rgb[1], e->product.rgb[2], e->shade_count);
+    fprintf(f, "loading_screens %d\nloading_stages %s\n", v->load.screens, v->load.screens_log);
     fprintf(f, "render_scale %.3f\nrender_scale_range %.3f %.3f\n", v->render_scale, v->scale_lo, v->scale_hi);
     fprintf(f, "looks_sheet %d\nsave_dialog %d\nsave_name %s\nsplit %d\nsplit_left %s\ntoast %s\n", v->looks.open,
             v->looks.saving, v->looks.name, v->split, v->looks.compare[0] ? v->looks.compare : "(bare)", v->toast);
@@ -981,10 +1039,9 @@ static double frame(vw_viewer *v, const vw_script_step *step, rs_error *err)
     double t0 = vw_now();
     v->rendered_this_frame = false;
     update_window_size(v);
-    // A face just made: its first picture takes seconds on a slow GPU (600k splats on a software
-    // rasteriser: ~3 s), so this frame only says so and the next one draws it. Until the face is there
-    // and drawn, input waits in the queue (nothing to act on yet; nothing is lost).
-    if (v->face && !v->drawing_first) {
+    // A face's first picture is made with the face (face_open: seconds on a slow GPU, shown stage by stage
+    // on the loading screen); until the face is there, input waits in the queue (nothing is lost).
+    if (v->face) {
         dispatch(v);
         rs_result r = render_scene(v, err);
         if (r) {
@@ -1010,7 +1067,6 @@ static double frame(vw_viewer *v, const vw_script_step *step, rs_error *err)
     if (step && step->screenshot) vw_write_png(v, step->screenshot, step->rect);
     if (step && step->state) write_state(v, step->state);
     glfwSwapBuffers(v->win);
-    v->drawing_first = false;
     v->frame_no++;
     // The script's `slow`: a slow device, to prove that input keeps arriving whole meanwhile.
     double slow_s = v->have_script ? v->script.slow_s : 0, left_s = t0 + slow_s - vw_now();
@@ -1034,12 +1090,14 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
         (!l->shown || now - l->last_preview >= VW_PREVIEW_EVERY_S)) {
         rouge_stream_progress p = rouge_stream_get_progress(l->stream);
         rs_error e = {0};
-        if (p.ready > l->shown && !p.complete && face_open(v, &e) == RS_OK) {
-            if (!v->partial) reset_camera(v);
-            // The last bytes may have arrived meanwhile: then this face is the whole one.
-            l->shown = v->info.splats, l->last_preview = now;
-            v->partial = l->shown < p.splats;
-            vw_apply_brush(v);
+        if (p.ready > l->shown && !p.complete) {
+            if (!v->partial) reset_camera(v);  // first: the face's first frame is made with the camera
+            if (face_open(v, &e) == RS_OK) {
+                // The last bytes may have arrived meanwhile: then this face is the whole one.
+                l->shown = v->info.splats, l->last_preview = now;
+                v->partial = l->shown < p.splats;
+                vw_apply_brush(v);
+            }
         }
     }
     if (!l->building) {
@@ -1057,8 +1115,9 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
     rs_error e = {0};
     rs_result r = (rs_result)l->result;
     if (r) rs_fail(&e, r, "%s", l->err.msg);
-    else if (!l->shown || was_partial) r = face_open(v, &e);
-    v->drawing_first = !r && (!l->shown || was_partial);
+    // The camera first, so the face's first frame (made with it) is the one shown.
+    if (!r && !l->shown) reset_camera(v);
+    if (!r && (!l->shown || was_partial)) r = face_open(v, &e);
     rouge_stream_destroy(l->stream);
     l->stream = NULL;
     v->partial = false;  // on failure a preview stays: all there is of that file
@@ -1068,7 +1127,6 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
         vw_toast(v, true, "%s", e.msg);
         return RS_OK;
     }
-    if (!l->shown) reset_camera(v);  // a preview of this file set the camera already
     if (l->initial && v->cli->look) {
         if ((r = vw_load_look_file(v, v->cli->look, err))) return r;
         vw_toast(v, false, "Loaded look %s", v->cli->look);

@@ -188,12 +188,17 @@ static void draw_loading(vw_viewer *v)
     const char *base = strrchr(v->load.path, '/');
     rouge_stream_progress p = v->load.stream ? rouge_stream_get_progress(v->load.stream) : (rouge_stream_progress){0};
     uint32_t decoded = p.decoded, count = p.splats;
-    // The stages after decoding, as they happen: making the face (GPU upload, shaders), then its first
-    // picture (seconds for a large face on a slow GPU).
-    if (v->drawing_first)
-        snprintf(line, sizeof line, "Loading %s: %u splats; drawing the first picture", base ? base + 1 : v->load.path,
-                 v->info.splats);
-    else if (v->load.building)
+    const rouge_progress *made = &v->load.made;
+    // The stages after decoding, as rouge_face_create reports them: making the face (GPU upload, makeup
+    // layer, lighting), then its first picture stage by stage (seconds for a large face on a slow GPU:
+    // the stages compile their shaders on first use), with a bar of the fraction done.
+    if (made->stage) {
+        snprintf(line, sizeof line, "Loading %s: %u splats; %s (%d of %d)", base ? base + 1 : v->load.path,
+                 count, made->stage, made->step, made->steps);
+        float bw = 240 * s, bh = 4 * s, bx = cx - bw * 0.5f, by = cy + 22 * s + 7.0f * (float)ts + 10 * s;
+        rs_ui_fill(v->ui, (rs_ui_rect){bx, by, bw, bh}, bh * 0.5f, (rs_ui_rgba){255, 255, 255, 30});
+        rs_ui_fill(v->ui, (rs_ui_rect){bx, by, bw * RS_CLAMP(made->fraction, 0.0f, 1.0f), bh}, bh * 0.5f, RS_UI_ACCENT);
+    } else if (v->load.building)
         snprintf(line, sizeof line, "Loading %s: %u splats decoded in %.1f s; building the face (GPU upload, shaders)",
                  base ? base + 1 : v->load.path, count, v->load.decoded_s);
     else if (count)
@@ -226,6 +231,13 @@ static void draw_env_chips(vw_viewer *v, const rs_ui_toolbar_layout *l)
     }
 }
 
+void vw_draw_loading_frame(vw_viewer *v)
+{
+    rs_ui_begin(v->ui, v->fb_w, v->fb_h, v->ui_scale, &(rs_ui_input){.x = -1, .y = -1});
+    draw_loading(v);
+    rs_ui_end(v->ui);
+}
+
 rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
 {
     rs_ui_input in = {.x = v->mx, .y = v->my, .down = v->ui_owns[0], .pressed = v->ui_pressed,
@@ -236,7 +248,7 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         draw_loading(v);
         return RS_UI_TOOL_NONE;
     }
-    if (v->load.running || v->load.building || v->drawing_first) draw_loading(v);
+    if (v->load.running || v->load.building) draw_loading(v);
     // The look library's sheet and dialog are modal: the toolbar steps aside while they are up.
     if (vw_looks_modal(v)) {
         *st = (rs_ui_toolbar_state){0};
@@ -274,7 +286,9 @@ rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch)
         .region_name = vw_brush_region(v),
         .size = vw_size_to_slider(v->size_rel), .opacity = v->opacity, .size_text = v->size_text,
         .opacity_text = v->opacity_text,
-        .light = {v->light_dial[0], v->light_dial[1]}, .paint = v->paint_mode, .eraser = v->eraser,
+        .light = {v->light_dial[0], v->light_dial[1]}, .paint = v->paint_mode,
+        .eraser = v->eraser && v->tool == ROUGE_TOOL_PAINT, .smudge = v->tool == ROUGE_TOOL_SMUDGE,
+        .blend = v->tool == ROUGE_TOOL_BLEND,
         .mirror = v->mirror, .keep_region = !v->any_region, .split = v->split, .hud = v->hud, .help = v->help,
         .can_undo = v->info.can_undo, .can_redo = v->info.can_redo,
         .mode = v->view.mode == ROUGE_MODE_ALBEDO ? 0 : v->view.mode == ROUGE_MODE_DIFFUSE ? 1 : 2,

@@ -174,6 +174,10 @@ typedef struct vw_loader {
     uint32_t shown;               // splats of the face on screen made from the stream (0: none)
     bool building;                // read and decoded: the face is made of it next frame (the screen says so)
     double decoded_s;             // ... how long reading and decoding took
+    rouge_progress made;          // while the face is made (rouge_face_create, its first frame included):
+                                  // the stage it reports (stage NULL otherwise)
+    int screens;                  // loading screens drawn between those stages (the script's `state`) ...
+    char screens_log[480];        // ... as "stage@fraction;" (the last face's)
 } vw_loader;
 
 // The look library (viewer_looks.c).
@@ -252,7 +256,6 @@ typedef struct vw_viewer {
     char face_path[512];
     vw_loader load;
     bool partial;  // the face shown is a preview of a file still loading: painting waits for the rest
-    bool drawing_first;  // the whole face was just made: this frame says its first picture comes next
 
     // Window (screen coordinates) and framebuffer (pixels).
     int win_w, win_h, fb_w, fb_h;
@@ -273,6 +276,7 @@ typedef struct vw_viewer {
     int cosmetic;  // preset index
     float size_rel, opacity;
     bool eraser, mirror;
+    rouge_tool tool;  // J: smudge, Shift+J: blend (ROUGE_TOOL_PAINT: the product or the eraser)
     bool any_region;  // K: paint anywhere instead of keeping to the product's region
 
     // Pointer. Gestures are measured in window coordinates (wx, wy: the events' own), so a render scale
@@ -381,6 +385,9 @@ void vw_draw_picture(vw_viewer *v, rs_ui *ui);
 // Begins v->ui's frame and draws the toolbar and overlays; returns the tool tapped (RS_UI_TOOL_NONE if
 // none) with the toolbar state after the frame's input in *st and the swatch in *swatch.
 rs_ui_tool vw_draw_ui(vw_viewer *v, rs_ui_toolbar_state *st, int *swatch);
+// One frame of the loading screen alone into the bound framebuffer (v->ui's list; the caller swaps): what a
+// face being made reports (v->load.made) between its stages.
+void vw_draw_loading_frame(vw_viewer *v);
 // Writes the bound framebuffer (or a region, window coordinates, when rect[2] > 0) as an RGB PNG.
 void vw_write_png(vw_viewer *v, const char *path, const float *rect);
 

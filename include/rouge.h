@@ -15,7 +15,8 @@
 //     pixel-store settings and an sRGB framebuffer (it writes so the picture is encoded once) do not
 //     change what it draws or reads;
 //   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
-//     through an ID buffer, one- and two-finger navigation; brush, eraser, mirror, undo / redo / clear;
+//     through an ID buffer, one- and two-finger navigation; brush, eraser, smudge and blend tools,
+//     mirror, undo / redo / clear;
 //   - save and load looks (the makeup) as files or memory, list the products in one (look_info), show a
 //     second look beside the painted one;
 //     custom products (colour, finish, coverage) on the brush; record and replay stroke files;
@@ -236,6 +237,15 @@ const char *rouge_environment_name(int i);
 typedef struct rouge_face rouge_face;
 typedef struct rouge_stream rouge_stream;
 
+// Where a rouge_face_create stands (rouge_face_desc.progress_stage).
+typedef struct rouge_progress {
+    float fraction;              // as rouge_face_desc.progress has it: 0..1, never decreasing
+    const char *stage;           // what runs from now (static): "reading the face", "uploading and compiling",
+                                 // "makeup layer", "lighting", then with first_frame "shadow map",
+                                 // "visibility", "attributes", "light and diffusion", "composite"; "done" last
+    int step, steps;             // this stage's number (1-based) and how many there are; step == steps: done
+} rouge_progress;
+
 typedef struct rouge_face_desc {
     const char *path;            // a .rsf file; or
     const void *data;            // the bytes of one (not kept after create); or
@@ -254,9 +264,21 @@ typedef struct rouge_face_desc {
     // start, then after each stage (the splats parsed and decoded, uploaded with the shaders compiled,
     // the makeup layer made, the environment uploaded), 1 last; never decreasing. Returning false cancels:
     // create frees what it made and returns ROUGE_ERR_CANCELLED ("cancelled"), *out untouched. It must not
-    // call rouge on this face (there is none yet).
+    // call rouge on this face (there is none yet). It may draw in the creating context (a loading
+    // screen, then swap buffers): your GL state is in place during the call, rouge's is put back after.
     bool (*progress)(void *user, float fraction);
-    void *progress_user;         // handed to progress
+    void *progress_user;         // handed to progress and progress_stage
+    // Also render the view's first frame before returning (as rouge_face_render would: into the face's
+    // texture, at the view's size, 0 = 512 x 512). Its stages compile their shaders on first use and make
+    // the shadow map and the light, seconds for a large face on a software GPU: inside create they are
+    // reported (and may be cancelled) like the rest, and the host's first render or draw of that view at
+    // that size only copies the frame out. The fractions are then about shares of the time: create's own
+    // stages take 0..0.1, the frame 0.1..1.
+    bool first_frame;
+    // Called (when not NULL) with progress, at the same moments, with the stage about to run by name and
+    // number (rouge_progress), e.g. for "Compiling: shadow map (5 of 10)". Returning false cancels, as
+    // progress. The same rules.
+    bool (*progress_stage)(void *user, const rouge_progress *p);
 } rouge_face_desc;
 
 // Loads the face and creates its GL objects in the current context. Blocks (file, shaders).
@@ -273,7 +295,8 @@ typedef struct rouge_stream_progress {
     uint32_t splats;             // the face's splat count once the header has arrived, else 0
     uint32_t decoded;            // splats decoded and checked
     uint32_t ready;              // splats a preview would show (a LOD prefix), 0 while none
-    bool complete;               // every byte has arrived: a face from the stream is the whole face
+    bool complete;               // every byte has arrived: a face from the stream is the whole face (and
+                                 // stays true, with the counts, once a face took the splats)
 } rouge_stream_progress;
 
 // `name` names the stream in messages (NULL = "(stream)"); total_bytes is the file's size when known
@@ -387,6 +410,22 @@ typedef enum rouge_finish {
     ROUGE_FINISH_SHIMMER,        // pigment-tinted flakes that glint (highlighter)
 } rouge_finish;
 
+// What a brush does with the makeup. DOES: smudge drags the product already on the face along the stroke
+// (what lies under the first stamp is picked up, laid down where the brush moves wherever it is stronger
+// than what is there, and mixed with what the brush passes over, so it fades along the drag: a higher
+// opacity carries it further); blend evens the makeup in place (each stamp lays its footprint's average
+// into the weaker part: a hard edge becomes a soft ramp, an even area stays). Both sample the whole
+// makeup (every product, both resolutions) on the face's own side (a mirrored stroke samples its
+// mirror side there), ignore the region mask and the cosmetic (the cosmetic only gives the default
+// size), and are recorded in stroke files and saved in looks like any painting (undo: one stroke).
+// DOES NOT: thin or remove product (a stroke only adds: smudging bare skin into a lipstick leaves it,
+// blending a hard edge feathers it outwards); use the eraser (eraser with a tool is ROUGE_ERR_ARG).
+typedef enum rouge_tool {
+    ROUGE_TOOL_PAINT = 0,        // lay the brush's product down (or erase, with eraser)
+    ROUGE_TOOL_SMUDGE,           // drag the makeup under the brush along the stroke
+    ROUGE_TOOL_BLEND,            // soften edges in place
+} rouge_tool;
+
 typedef struct rouge_brush {
     const char *cosmetic;        // a preset name (rouge_cosmetic_get); NULL = "foundation_1"
     // A custom product made from the preset (it keeps the preset's kind, region and brush; looks record it
@@ -405,6 +444,8 @@ typedef struct rouge_brush {
     // products unmasked. A brush narrower than 4 mm (liner, brow pencil, mascara at their sizes) is
     // drawn per pixel exactly where it is painted and is not masked: a pencil is its own mask.
     bool any_region;
+    // 0 = paint. With smudge or blend, opacity is the tool's strength (0 = 0.8) and size its size.
+    rouge_tool tool;
 } rouge_brush;
 
 typedef struct rouge_cosmetic {

@@ -193,6 +193,7 @@ struct rouge_stream {
     rs_splat_loader *ld;
     uint64_t bytes;
     bool taken;                   // a complete stream's splats went to a face
+    rouge_stream_progress final;  // its progress then: the loader forgets it, the reading thread must not
 };
 
 static rouge_result fail_out(rouge_error *out, const rs_error *e)
@@ -271,14 +272,20 @@ rouge_result rouge_stream_feed(rouge_stream *s, const void *data, size_t size, r
     return r ? fail_out(err, &e) : ROUGE_OK;
 }
 
+static rouge_stream_progress stream_progress(rouge_stream *s)
+{
+    if (s->taken) return s->final;
+    const rs_splat_header *h = rs_splat_loader_header(s->ld);
+    return (rouge_stream_progress){.bytes = s->bytes, .splats = h ? h->count : 0,
+                                   .decoded = rs_splat_loader_decoded(s->ld), .ready = rs_splat_loader_ready(s->ld),
+                                   .complete = rs_splat_loader_complete(s->ld)};
+}
+
 rouge_stream_progress rouge_stream_get_progress(rouge_stream *s)
 {
     if (!s) return (rouge_stream_progress){0};
     pthread_mutex_lock(&s->mu);
-    const rs_splat_header *h = rs_splat_loader_header(s->ld);
-    rouge_stream_progress p = {.bytes = s->bytes, .splats = h ? h->count : 0,
-                               .decoded = rs_splat_loader_decoded(s->ld), .ready = rs_splat_loader_ready(s->ld),
-                               .complete = rs_splat_loader_complete(s->ld)};
+    rouge_stream_progress p = stream_progress(s);
     pthread_mutex_unlock(&s->mu);
     return p;
 }
@@ -300,8 +307,12 @@ static rs_result stream_cloud(rouge_stream *s, rs_splat_cloud **out, rs_error *e
     if (s->taken) {
         r = rs_fail(e, RS_ERR_ARG, "stream: its splats already went to a face");
     } else if (rs_splat_loader_complete(s->ld)) {
+        // Still complete after the hand-over: a reading thread that checks between its last bytes and
+        // its exit must not take the stream for a truncated one.
+        rouge_stream_progress p = stream_progress(s);
         r = rs_splat_loader_finish(s->ld, out, e);
         s->taken = r == RS_OK;
+        s->final = p;
     } else {
         uint32_t ready = rs_splat_loader_ready(s->ld);
         r = ready ? rs_splat_loader_preview(s->ld, ready, out, e)
@@ -369,16 +380,31 @@ typedef struct gl_saved {
 // are taken off the context (the renderer's checks must see only rouge's own, and GL cannot put them
 // back) and the first is kept for rouge_face_take_host_gl_error; then the state is saved. Nothing is
 // saved on failure (no gl_restore then).
-static rs_result gl_save(rouge_face *f, gl_saved *s, rs_error *e)
+static void gl_capture(gl_saved *s);
+
+// The GL errors the host left pending: off the context, the first kept for rouge_face_take_host_gl_error.
+static void take_host_errors(rouge_face *f)
 {
-    rs_result r = check_context(f, e);
-    if (r) return r;
     // Bounded: a lost context may report its loss more than once.
     for (int i = 0; i < 32; i++) {
         GLenum pending = glGetError();
         if (pending == GL_NO_ERROR) break;
         if (!f->host_gl_error) f->host_gl_error = pending;
     }
+}
+
+static rs_result gl_save(rouge_face *f, gl_saved *s, rs_error *e)
+{
+    rs_result r = check_context(f, e);
+    if (r) return r;
+    take_host_errors(f);
+    gl_capture(s);
+    return RS_OK;
+}
+
+// Saves the state rouge touches into s, then sets rouge's defaults (pixel store, no scissor, ...).
+static void gl_capture(gl_saved *s)
+{
     glGetIntegerv(GL_DRAW_FRAMEBUFFER_BINDING, &s->draw_fbo);
     glGetIntegerv(GL_READ_FRAMEBUFFER_BINDING, &s->read_fbo);
     glGetIntegerv(GL_VIEWPORT, s->viewport);
@@ -425,7 +451,6 @@ static rs_result gl_save(rouge_face *f, gl_saved *s, rs_error *e)
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, 0);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
-    return RS_OK;
 }
 
 static void gl_enable(GLenum cap, GLboolean on)
@@ -903,12 +928,83 @@ static void dir_cb(void *user, const float pos[3], float dir[3])
 
 // --- lifecycle -------------------------------------------------------------------------------------------
 
-// The host's progress callback (rouge_face_desc.progress): RS_OK to go on, else the cancellation (a code
-// only the public API has) in e.
-static rs_result progress(const rouge_face_desc *d, float fraction, rs_error *e)
+// Create's stages as rouge_progress names them: its own, then (first_frame) the first frame's, then "done".
+static const char *const create_stages[] = {"reading the face", "uploading and compiling", "makeup layer", "lighting"};
+static const char *const frame_stages[RS_STAGE_COUNT] = {"shadow map", "visibility", "attributes",
+                                                         "light and diffusion", "composite"};
+// The first frame's stages' shares of its time (the bundled face on llvmpipe, 320 x 240 to 1280 x 800:
+// the shadow map 30-50 %, as it compiles the first shaders; the rest 10-20 % each), cumulative: where
+// the fraction stands as each begins.
+static const float frame_share_before[RS_STAGE_COUNT] = {0.0f, 0.35f, 0.5f, 0.7f, 0.88f};
+#define CREATE_SHARE_WITH_FRAME 0.1f  // create's own stages, when the first frame follows
+
+typedef struct create_progress {
+    const rouge_face_desc *d;
+    int step, steps;
+} create_progress;
+
+// The host's progress callbacks (rouge_face_desc.progress, progress_stage): RS_OK to go on, else the
+// cancellation (a code only the public API has) in e. `fraction` is of the whole create.
+static rs_result progress(create_progress *p, float fraction, const char *stage, rs_error *e)
 {
-    if (!d->progress || d->progress(d->progress_user, fraction)) return RS_OK;
-    return rs_fail(e, (rs_result)ROUGE_ERR_CANCELLED, "cancelled");
+    const rouge_face_desc *d = p->d;
+    p->step = RS_MIN(p->step + 1, p->steps);
+    bool go = !d->progress || d->progress(d->progress_user, fraction);
+    if (go && d->progress_stage) {
+        rouge_progress pr = {fraction, stage, p->step, p->steps};
+        go = d->progress_stage(d->progress_user, &pr);
+    }
+    return go ? RS_OK : rs_fail(e, (rs_result)ROUGE_ERR_CANCELLED, "cancelled");
+}
+
+// Create's own stage k (0..3) at its fraction of create without a first frame.
+static rs_result create_stage(create_progress *p, int k, float fraction, rs_error *e)
+{
+    return progress(p, p->d->first_frame ? fraction * CREATE_SHARE_WITH_FRAME : fraction, create_stages[k], e);
+}
+
+typedef struct first_frame_ctx {
+    rouge_face *f;
+    create_progress *p;
+    gl_saved *host;
+    bool cancelled;
+} first_frame_ctx;
+
+// The renderer's stage hook during the first frame: the host's GL state is put back for its callbacks (a
+// loading screen may draw and swap), rouge's after them.
+static bool first_frame_stage(void *user, rs_render_stage next)
+{
+    first_frame_ctx *x = user;
+    if (next >= RS_STAGE_COUNT) return true;  // "done" comes from create, last
+    gl_saved mine;
+    gl_capture(&mine);
+    gl_restore(x->host);
+    rs_error e = {0};
+    float fraction = CREATE_SHARE_WITH_FRAME + (1.0f - CREATE_SHARE_WITH_FRAME) * frame_share_before[next];
+    x->cancelled = progress(x->p, fraction, frame_stages[next], &e) != RS_OK;
+    take_host_errors(x->f);  // the host's own, not the frame's
+    gl_capture(x->host);
+    gl_restore(&mine);
+    return !x->cancelled;
+}
+
+static rs_result render_at(rouge_face *f, int w, int h, rs_error *e);
+
+// rouge_face_desc.first_frame: the view's first frame, its stages reported.
+static rs_result render_first_frame(rouge_face *f, create_progress *p, rs_error *e)
+{
+    gl_saved s;
+    rs_result r = gl_save(f, &s, e);
+    if (r) return r;
+    first_frame_ctx x = {f, p, &s, false};
+    // Without callbacks there is nothing to report (and no glFinish between the stages is needed).
+    if (p->d->progress || p->d->progress_stage) rs_render_set_stage_hook(f->ren, first_frame_stage, &x);
+    r = render_at(f, f->view.width > 0 ? f->view.width : ROUGE_DEFAULT_SIZE,
+                  f->view.height > 0 ? f->view.height : ROUGE_DEFAULT_SIZE, e);
+    rs_render_set_stage_hook(f->ren, NULL, NULL);
+    gl_restore(&s);
+    if (x.cancelled) return rs_fail(e, (rs_result)ROUGE_ERR_CANCELLED, "cancelled");
+    return r;
 }
 
 rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, rouge_error *err)
@@ -917,7 +1013,8 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
     if (!desc || !out) return fail_arg(err, "rouge_face_create: desc and out are required");
     if (!desc->path && !desc->data && !desc->stream)
         return fail_arg(err, "rouge_face_create: desc needs a path, data or a stream");
-    if (progress(desc, 0.0f, &e)) return fail_out(err, &e);
+    create_progress cp = {desc, 0, (int)RS_COUNT_OF(create_stages) + (desc->first_frame ? RS_STAGE_COUNT : 0) + 1};
+    if (create_stage(&cp, 0, 0.0f, &e)) return fail_out(err, &e);
     rs_gl_caps caps = {0};
     if (rs_gl_query_caps(&caps, &e) != RS_OK) return fail_out(err, &e);
     rouge_face *f = calloc(1, sizeof *f);
@@ -939,7 +1036,7 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
                   : desc->stream ? stream_cloud(desc->stream, &f->cloud, &e)
                                  : rs_splat_load_memory(desc->data, desc->size, &f->cloud, &e);
     // Parsing and decoding take about half of create, the upload and shaders most of the rest.
-    if (!r) r = progress(desc, 0.5f, &e);
+    if (!r) r = create_stage(&cp, 1, 0.5f, &e);
     gl_saved s;
     if (!r && !(r = gl_save(f, &s, &e))) {
         r = rs_render_create(&(rs_render_desc){.cloud = f->cloud, .caps = &caps,
@@ -947,7 +1044,7 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
                              &f->ren, &e);
         gl_restore(&s);
     }
-    if (!r) r = progress(desc, 0.85f, &e);
+    if (!r) r = create_stage(&cp, 2, 0.85f, &e);
     if (!r) r = rs_makeup_create(f->cloud, &(rs_makeup_desc){.undo_levels = desc->undo_levels}, &f->mk, &e);
     rs_paint_picker pk = {.user = f, .pick = pick_cb, .pixels_per_unit = ppu_cb, .view_dir = dir_cb};
     if (!r) r = rs_paint_create(f->mk, &pk, &(rs_paint_desc){.input.mode = RS_INPUT_PAINT}, &f->paint, &e);
@@ -956,15 +1053,17 @@ rouge_result rouge_face_create(const rouge_face_desc *desc, rouge_face **out, ro
         rs_makeup_uniforms u;
         rs_makeup_get_uniforms(f->mk, &u);
         rs_render_set_makeup_uniforms(f->ren, &u);
-        r = progress(desc, 0.9f, &e);
+        r = create_stage(&cp, 3, 0.9f, &e);
     }
     rouge_result pr = r ? ROUGE_OK : rouge_face_set_view(f, desc->view, err);
-    if (!r && !pr) r = progress(desc, 1.0f, &e);
+    if (!r && !pr && desc->first_frame) r = render_first_frame(f, &cp, &e);
+    cp.step = cp.steps - 1;
+    if (!r && !pr) r = progress(&cp, 1.0f, "done", &e);
     if (r || pr) {
         rouge_face_destroy(f);
         return r ? fail_out(err, &e) : pr;
     }
-    f->changed = true;
+    f->changed = !f->have_frame;
     *out = f;
     return ROUGE_OK;
 }
@@ -1238,11 +1337,18 @@ rouge_result rouge_face_set_brush(rouge_face *f, const rouge_brush *brush, rouge
     if (!(b.size >= 0 && b.size <= 2) || !(b.opacity >= 0 && b.opacity <= 1))
         return fail_arg(err, "brush: size must be 0..2 (face heights), opacity 0..1");
     if ((unsigned)b.finish > ROUGE_FINISH_SHIMMER) return fail_arg(err, "brush: unknown finish");
+    if ((unsigned)b.tool > ROUGE_TOOL_BLEND) {
+        rs_error e = {0};
+        rs_fail(&e, RS_ERR_ARG, "brush: unknown tool %d (0 paint, 1 smudge, 2 blend)", (int)b.tool);
+        return fail_out(err, &e);
+    }
+    if (b.tool != ROUGE_TOOL_PAINT && b.eraser)
+        return fail_arg(err, "brush: eraser and a smudge or blend tool at once (the eraser is a paint tool)");
     if (!(b.coverage <= 1) || !(b.color[3] >= 0) || !isfinite(b.color[0] + b.color[1] + b.color[2]))
         return fail_arg(err, "brush: coverage must be <= 1, the colour finite with alpha >= 0");
     rs_paint_brush pb = {.cosmetic = *c, .size_rel = b.size, .opacity = b.opacity,
                          .pressure = (rs_makeup_pressure)b.pressure, .eraser = b.eraser, .mirror = b.mirror,
-                         .any_region = b.any_region};
+                         .any_region = b.any_region, .tool = (rs_paint_tool)b.tool};
     if (b.color[3] > 0 || b.finish != ROUGE_FINISH_DEFAULT || b.coverage != 0) {
         // A custom product of the preset's kind: a recoloured lipstick still belongs on the lips.
         rs_cosmetic *pc = &pb.cosmetic;

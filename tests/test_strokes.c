@@ -59,7 +59,7 @@ static void test_round_trip_is_identical(void)
     rs_error err = {0};
     REQUIRE(rs_strokes_create(&doc, &err) == RS_OK);
     rs_strokes_view v = {12.5f, -7.25f, 1.3f, 30.0f, 640, 480, {0.125f, -0.0625f}};  // pan round-trips too
-    rs_strokes_brush b = {0.2f, 0.6f, RS_MAKEUP_PRESSURE_LINEAR, true, false, true};
+    rs_strokes_brush b = {0.2f, 0.6f, RS_MAKEUP_PRESSURE_LINEAR, true, false, true, RS_TOOL_PAINT};
     rs_cosmetic custom = *rs_cosmetic_find("lipstick_satin");
     rs_cosmetic_hsv_to_rgb(330.0f, 0.55f, 0.8f, custom.rgb);
     snprintf(custom.name, sizeof custom.name, "my_pink");

@@ -34,7 +34,8 @@ viewer_look_library_saves_refuses_clashes_loads_compares_deletes
 viewer_product_editor_paints_and_saves_a_custom_product
 viewer_slow_frames_lose_no_input_and_orbit_by_the_drag viewer_compare_and_export_do_what_they_say
 viewer_product_editor_keeps_the_face_at_full_quality viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek
-viewer_eyedropper_takes_the_face_colour_into_the_editor viewer_my_shades_persist_and_can_be_picked_again"
+viewer_eyedropper_takes_the_face_colour_into_the_editor viewer_my_shades_persist_and_can_be_picked_again
+viewer_loading_reports_the_first_frame_stages_and_j_smudges"
 skip_all() {
     for t in $tests; do selected "$t" && echo "skip - $t: $1"; done
     exit 0
@@ -750,6 +751,36 @@ if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
         umount "$out/full"
     else
         echo "skip - $name: cannot mount a tmpfs here (needs root)"
+    fi
+fi
+if selected viewer_loading_reports_the_first_frame_stages_and_j_smudges; then
+    # Loading shows real progress: the face is made with its first frame, and the loading screen is drawn
+    # at each stage create reports (ten: reading .. lighting, the frame's five, done), fractions never
+    # going back. Then the smudge tool (J): a lipstick stripe dragged down carries its colour below it.
+    name=viewer_loading_reports_the_first_frame_stages_and_j_smudges
+    d="$out/smudge"
+    mkdir -p "$d"
+    printf 'loaded\nstate %s/s0.txt\nkey p\nkey 9\nkey k\ndrag 340 140 460 140 12\nmove 400 580\nidle\nscreenshot %s/a.png 330 100 140 130\nkey j\ndrag 400 140 400 215 12\nmove 400 580\nidle\nscreenshot %s/b.png 330 100 140 130\nscreenshot %s/far.png 80 260 630 150\nstate %s/s1.txt\nquit\n' \
+        "$d" "$d" "$d" "$d" "$d" >"$d/smudge.events"
+    view --events "$d/smudge.events" >"$d/smudge.log" 2>&1
+    rc=$?
+    sval() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$d/$1.txt" 2>/dev/null; }
+    stages=$(sval s0 loading_stages)
+    # Below the stripe (y 160..215 of the window: rows 60..115 of the shots), the smudge's column changed.
+    below=$("$imgdiff" "$d/a.png" "$d/b.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
+    if [ $rc -ne 0 ] || [ ! -f "$d/s1.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$d/smudge.log")"
+    elif [ "$(sval s0 loading_screens)" != 10 ] ||
+        ! echo "$stages" | awk -F';' '{
+            want = "reading the face|uploading and compiling|makeup layer|lighting|shadow map|visibility|attributes|light and diffusion|composite|done"
+            n = split(want, w, "|"); last = -1
+            for (i = 1; i <= n; i++) { split($i, kv, "@"); if (kv[1] != w[i] || kv[2] + 0 < last) exit 1; last = kv[2] + 0 }
+            exit !(last == 1) }'; then
+        echo "FAIL - $name: loading screens $(sval s0 loading_screens): $stages"
+    elif ! awk -v f="${below:-0}" 'BEGIN { exit !(f > 0.02) }'; then
+        echo "FAIL - $name: J and a drag down from the stripe changed ${below:-error} of the area ($d/a.png, b.png)"
+    else
+        echo "ok - $name"
+        echo "# loading screens: $stages; the smudge changed $below of the stripe's area"
     fi
 fi
 exit 0

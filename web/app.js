@@ -17,6 +17,7 @@ const canvas = $('#face');
 
 const LOOKS_KEY = 'rouge.looks';
 const SIZE_MIN = 0.02, SIZE_MAX = 0.40;  // brush diameter / face height at the size slider's ends (log scale)
+const SMUDGE_STRENGTH = 0.8;  // a smudge or blend brush's opacity when none is set (RS_SMUDGE_STRENGTH_DEFAULT)
 const ORBIT_STEP = 10;                   // degrees per arrow key
 const ZOOM_STEP = 1.12;
 const HOLD_MS = 350;                     // a longer press on before/after shows the bare face only while held
@@ -174,13 +175,14 @@ const ui = {
     edit: { color: null, finish: 'default', coverage: 0 },  // the product editor's changes to the preset
     size: 0, opacity: 0,                                     // 0: the product's own
     eraser: false, mirror: false, anyRegion: false, painting: true, hide: false,
+    tool: 'paint',                                           // 'smudge' | 'blend': move / soften the makeup
     env: 'studio', envRotation: 0, pipeline: 'mobile', start: {},
 };
 
 const pretty = (s) => s.replace(/_/g, ' ').replace(/^./, (c) => c.toUpperCase());
 const hex = (rgb) => `#${rgb.map((v) => Math.round(v).toString(16).padStart(2, '0')).join('')}`;
 const sizeOf = () => ui.size || ui.product.size;
-const opacityOf = () => ui.opacity || ui.product.opacity;
+const opacityOf = () => ui.opacity || (ui.tool === 'paint' ? ui.product.opacity : SMUDGE_STRENGTH);
 const sizeToSlider = (s) => 1000 * Math.log(Math.min(Math.max(s, SIZE_MIN), SIZE_MAX) / SIZE_MIN) / Math.log(SIZE_MAX / SIZE_MIN);
 const sliderToSize = (v) => SIZE_MIN * Math.pow(SIZE_MAX / SIZE_MIN, v / 1000);
 const isCustom = () => ui.edit.color !== null || ui.edit.finish !== 'default' || ui.edit.coverage !== 0;
@@ -286,7 +288,8 @@ function pickProduct(p) {
     ui.edit = { color: null, finish: 'default', coverage: 0 };
     ui.size = 0, ui.opacity = 0;
     ui.eraser = false;
-    setBrush({ cosmetic: p.name, color: null, finish: 'default', coverage: 0, size: 0, opacity: 0, eraser: false }, 'Product');
+    ui.tool = 'paint';
+    setBrush({ cosmetic: p.name, color: null, finish: 'default', coverage: 0, size: 0, opacity: 0, eraser: false, tool: 'paint' }, 'Product');
     if (!ui.painting) setPainting(true);
     syncControls();
     showSwatch();
@@ -300,8 +303,24 @@ function setPainting(on) {
 
 function toggle(key, brushKey = key) {
     ui[key] = !ui[key];
-    setBrush({ [brushKey]: ui[key] });
+    if (key === 'eraser' && ui.eraser && ui.tool !== 'paint') {
+        ui.tool = 'paint';
+        setBrush({ tool: 'paint', eraser: true });
+    } else {
+        setBrush({ [brushKey]: ui[key] });
+    }
     if (key === 'eraser' && ui.eraser && !ui.painting) setPainting(true);
+    syncControls();
+}
+
+// Smudge or blend on (the eraser off), or the same again: back to the product.
+function setTool(t) {
+    ui.tool = ui.tool === t ? 'paint' : t;
+    ui.eraser = false;
+    setBrush({ tool: ui.tool, eraser: false }, 'Tool');
+    if (ui.tool !== 'paint' && !ui.painting) setPainting(true);
+    if (ui.tool === 'smudge') toast('Smudge: drag from the makeup to carry it along');
+    else if (ui.tool === 'blend') toast('Blend: brush over an edge to soften it');
     syncControls();
 }
 
@@ -528,9 +547,11 @@ function syncControls() {
     pressed($('#mode-paint'), ui.painting);
     pressed($('#mode-view'), !ui.painting);
     pressed($('#eraser'), ui.eraser);
+    pressed($('#smudge'), ui.tool === 'smudge');
+    pressed($('#blend'), ui.tool === 'blend');
     pressed($('#mirror'), ui.mirror);
-    pressed($('#region'), !ui.anyRegion && !!p.region);
-    $('#region').disabled = !p.region;
+    pressed($('#region'), !ui.anyRegion && !!p.region && ui.tool === 'paint');
+    $('#region').disabled = !p.region || ui.tool !== 'paint';  // smudge and blend keep to no region
     $('#region span').textContent = p.region ? `${pretty(p.region)} only` : 'Anywhere';
     pressed($('#before'), ui.hide);
     for (const b of document.querySelectorAll('.swatch')) {
@@ -541,8 +562,8 @@ function syncControls() {
         b.style.setProperty('--c', on && ui.edit.color ? ui.edit.color : hex(ui.products.find((x) => x.name === b.dataset.name).rgb));
     }
     const name = $('#product-name');
-    name.replaceChildren(ui.eraser ? 'Eraser' : pretty(p.name));
-    const notes = [ui.eraser ? `for ${pretty(p.name).toLowerCase()}` : '', isCustom() ? 'edited' : '', p.region && !ui.anyRegion ? `stays on ${p.region}` : ''].filter(Boolean);
+    name.replaceChildren(ui.tool !== 'paint' ? pretty(ui.tool) : ui.eraser ? 'Eraser' : pretty(p.name));
+    const notes = ui.tool !== 'paint' ? [ui.tool === 'smudge' ? 'drags the makeup along' : 'softens its edges'] : [ui.eraser ? `for ${pretty(p.name).toLowerCase()}` : '', isCustom() ? 'edited' : '', p.region && !ui.anyRegion ? `stays on ${p.region}` : ''].filter(Boolean);
     if (notes.length) {
         const small = document.createElement('small');
         small.textContent = ` · ${notes.join(' · ')}`;
@@ -588,6 +609,8 @@ function wire() {
     $('#undo').addEventListener('click', () => undo());
     $('#redo').addEventListener('click', () => undo(true));
     $('#eraser').addEventListener('click', () => toggle('eraser'));
+    $('#smudge').addEventListener('click', () => setTool('smudge'));
+    $('#blend').addEventListener('click', () => setTool('blend'));
     $('#mirror').addEventListener('click', () => toggle('mirror'));
     $('#region').addEventListener('click', () => toggle('anyRegion'));
     $('#shot').addEventListener('click', screenshot);
@@ -687,6 +710,7 @@ function onKey(e) {
         const actions = {
             p: () => setPainting(!ui.painting),
             e: () => toggle('eraser'),
+            j: () => setTool(e.shiftKey ? 'blend' : 'smudge'),
             m: () => toggle('mirror'),
             k: () => { toggle('anyRegion'); toast(ui.anyRegion ? 'The brush paints anywhere' : 'The brush stays in its area'); },
             b: () => setHide(!ui.hide),

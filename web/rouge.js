@@ -11,7 +11,7 @@
 //     pen's pressure sets opacity, and while a pen is down touches are ignored (palm rejection); the wheel
 //     zooms. Every event (getCoalescedEvents too) is queued and applied in order before the next frame:
 //     none is dropped or merged away when frames are slow;
-//   - brush, eraser, mirror, region-aware painting, custom products, undo / redo / clear, looks as text,
+//   - brush, eraser, smudge and blend tools, mirror, region-aware painting, custom products, undo / redo / clear, looks as text,
 //     a comparison look, pixels and PNG screenshots.
 // DOES NOT:
 //   - draw any controls (the page does: web/index.html), store looks (the page keeps them in
@@ -40,6 +40,7 @@ const MODES = ['full', 'albedo', 'diffuse', 'specular', 'normals', 'regions', 's
 const PIPELINES = { default: 0, mobile: 1, reference: 2 };
 const FINISHES = ['default', 'matte', 'satin', 'gloss', 'shimmer'];
 const PRESSURES = ['floor', 'linear', 'none'];
+const TOOLS = ['paint', 'smudge', 'blend'];  // rouge_tool
 const POINTER = { down: 0, move: 1, up: 2, cancel: 3 };
 const RESULT_NAMES = ['ROUGE_OK', 'ROUGE_ERR_IO', 'ROUGE_ERR_FORMAT', 'ROUGE_ERR_LIMIT', 'ROUGE_ERR_NOMEM',
                       'ROUGE_ERR_GL', 'ROUGE_ERR_ARG', 'ROUGE_ERR_CANCELLED'];
@@ -57,7 +58,7 @@ const DEFAULT_VIEW = {
 };
 const DEFAULT_BRUSH = {
     cosmetic: 'lipstick_satin', color: null, finish: 'default', coverage: 0, size: 0, opacity: 0,
-    pressure: 'floor', eraser: false, mirror: false, anyRegion: false,
+    pressure: 'floor', eraser: false, mirror: false, anyRegion: false, tool: 'paint',
 };
 
 let coreModule = null;  // the wasm module is stateless apart from the faces made in it: one per page
@@ -319,7 +320,8 @@ class Rouge {
             if (!Number.isFinite(b[k])) throw new RougeError(`brush.${k} must be a finite number`);
         return this.M._rw_set_brush(this.app, this._str(b.cosmetic || ''), c[0], c[1], c[2], c[3],
                                     enumIndex(FINISHES, b.finish, 'brush.finish'), b.coverage, b.size, b.opacity,
-                                    enumIndex(PRESSURES, b.pressure, 'brush.pressure'), b.eraser, b.mirror, b.anyRegion);
+                                    enumIndex(PRESSURES, b.pressure, 'brush.pressure'), b.eraser, b.mirror, b.anyRegion,
+                                    enumIndex(TOOLS, b.tool || 'paint', 'brush.tool'));
     }
 
     // ---- the queue and the frame ----
@@ -532,7 +534,9 @@ class Rouge {
     }
 
     // Merges `b` into the brush ({cosmetic, color: '#rrggbb' | [r, g, b, a] | null, finish, coverage, size,
-    // opacity, pressure: 'floor'|'linear'|'none', eraser, mirror, anyRegion}).
+    // opacity, pressure: 'floor'|'linear'|'none', eraser, mirror, anyRegion, tool: 'paint'|'smudge'|'blend'}).
+    // tool (rouge_brush.tool): smudge drags the makeup on the face along the stroke, blend softens its edges;
+    // opacity is then the tool's strength (0: 0.8), and the eraser must be off.
     setBrush(b) {
         return this._enqueue(() => {
             const old = this.brush;

@@ -215,12 +215,12 @@ RW_API void rw_get_view(const rw_app *a, float *out)
 
 RW_API int rw_set_brush(rw_app *a, const char *cosmetic, float r, float g, float b, float alpha, int finish,
                         float coverage, float size, float opacity, int pressure, bool eraser, bool mirror,
-                        bool any_region)
+                        bool any_region, int tool)
 {
     rouge_brush br = {
         .color = {r, g, b, alpha}, .finish = (rouge_finish)finish, .coverage = coverage, .size = size,
         .opacity = opacity, .pressure = (rouge_pressure)pressure, .eraser = eraser, .mirror = mirror,
-        .any_region = any_region,
+        .any_region = any_region, .tool = (rouge_tool)tool,
     };
     char name[sizeof a->cosmetic];
     snprintf(name, sizeof name, "%s", cosmetic ? cosmetic : "");

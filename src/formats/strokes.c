@@ -67,6 +67,10 @@ static rs_result check_brush(const rs_strokes_brush *b, rs_error *err)
         return rs_fail(err, RS_ERR_FORMAT, "brush: opacity: %g not in [0, 1]", b->opacity);
     if ((unsigned)b->pressure >= RS_MAKEUP_PRESSURE_COUNT)
         return rs_fail(err, RS_ERR_FORMAT, "brush: pressure: unknown map");
+    if ((unsigned)b->tool >= RS_TOOL_COUNT) return rs_fail(err, RS_ERR_FORMAT, "brush: tool: unknown tool %d", (int)b->tool);
+    if (b->tool != RS_TOOL_PAINT && b->eraser)
+        return rs_fail(err, RS_ERR_FORMAT, "brush: tool: %s with eraser=1 (the eraser is a paint tool)",
+                       rs_paint_tool_name(b->tool));
     return RS_OK;
 }
 
@@ -226,13 +230,14 @@ static rs_result parse_view(parser *p, char **save)
 
 static rs_result parse_brush(parser *p, char **save)
 {
-    static const char *const keys[] = {"size", "opacity", "pressure", "mirror", "eraser", "mask"};
-    bool seen[6] = {false};
+    // tool is optional (files written before it have none: paint).
+    static const char *const keys[] = {"size", "opacity", "pressure", "mirror", "eraser", "mask", "tool"};
+    bool seen[7] = {false};
     rs_strokes_brush b = {0};
     char *tok, *key, *val;
     while ((tok = strtok_r(NULL, " \t", save)) != NULL) {
         if (!split_kv(tok, &key, &val)) return perr(p, "brush: '%.64s' is not key=value", tok);
-        int k = key_index(key, keys, 6);
+        int k = key_index(key, keys, 7);
         if (k < 0) return perr(p, "brush: unknown key '%.32s'", key);
         if (seen[k]) return perr(p, "brush: %s given twice", key);
         seen[k] = true;
@@ -246,6 +251,9 @@ static rs_result parse_brush(parser *p, char **save)
             int m = key_index(val, pressure_names, RS_MAKEUP_PRESSURE_COUNT);
             ok = m >= 0;
             if (ok) b.pressure = (rs_makeup_pressure)m;
+        } else if (k == 6) {
+            ok = rs_paint_tool_parse(val, &b.tool);
+            if (!ok) return perr(p, "brush: tool: '%.32s' is not a tool (paint, smudge, blend)", val);
         } else {
             ok = rs_text_parse_uint(val, 1, &flag);
             if (k == 3) b.mirror = flag;
@@ -381,9 +389,11 @@ rs_result rs_strokes_write_memory(const rs_strokes *doc, char **out, size_t *out
         }
         if (!prev || br->size_rel != prev->brush.size_rel || br->opacity != prev->brush.opacity ||
             br->pressure != prev->brush.pressure || br->mirror != prev->brush.mirror ||
-            br->eraser != prev->brush.eraser || br->any_region != prev->brush.any_region)
-            rs_text_printf(&b, "brush size=%.9g opacity=%.9g pressure=%s mirror=%d eraser=%d mask=%d\n", br->size_rel,
+            br->eraser != prev->brush.eraser || br->any_region != prev->brush.any_region || br->tool != prev->brush.tool) {
+            rs_text_printf(&b, "brush size=%.9g opacity=%.9g pressure=%s mirror=%d eraser=%d mask=%d", br->size_rel,
                       br->opacity, rs_strokes_pressure_name(br->pressure), br->mirror, br->eraser, !br->any_region);
+            rs_text_printf(&b, br->tool != RS_TOOL_PAINT ? " tool=%s\n" : "\n", rs_paint_tool_name(br->tool));
+        }
         if (!prev || !rs_cosmetic_equal(&s->cosmetic, &prev->cosmetic)) {
             char c[512];
             rs_cosmetic_format(&s->cosmetic, c, sizeof c);

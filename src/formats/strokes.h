@@ -17,6 +17,7 @@
 #include "core/core.h"
 #include "makeup/cosmetics.h"
 #include "makeup/makeup.h"
+#include "makeup/smudge.h"
 
 #define RS_STROKES_VERSION 1
 #define RS_STROKES_MAX_BYTES (32u << 20)   // whole file
@@ -41,6 +42,7 @@ typedef struct rs_strokes_brush {
     rs_makeup_pressure pressure;    // file: pressure=floor|linear|none
     bool mirror, eraser;
     bool any_region;                // file: mask=0 (paint anywhere); mask=1 or absent: keep to the product's region
+    rs_paint_tool tool;             // file: tool=smudge|blend (absent: paint; written only when not paint)
 } rs_strokes_brush;
 
 typedef struct rs_strokes_sample {

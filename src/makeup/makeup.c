@@ -920,6 +920,32 @@ bool rs_makeup_nearest(const rs_makeup *mk, const float pos[3], float max_dist, 
     return true;
 }
 
+typedef struct near_ctx {
+    const rs_makeup *mk;
+    const float *p;
+    float r2;
+    rs_makeup_near_fn fn;
+    void *user;
+} near_ctx;
+
+static bool near_cell(void *user, const grid_cell *gc)
+{
+    near_ctx *x = user;
+    for (uint32_t k = gc->start; k < gc->start + gc->count; k++) {
+        uint32_t i = x->mk->order[k];
+        float d2 = dist2(x->mk->cloud->pos[i], x->p);
+        if (d2 < x->r2 && !x->fn(x->user, i, d2)) return false;
+    }
+    return true;
+}
+
+void rs_makeup_for_each_near(const rs_makeup *mk, const float pos[3], float radius, rs_makeup_near_fn fn, void *user)
+{
+    if (!(radius > 0.0f) || !isfinite(pos[0] + pos[1] + pos[2])) return;
+    near_ctx x = {mk, pos, radius * radius, fn, user};
+    for_cells(mk, pos, radius, near_cell, &x, NULL);
+}
+
 static uint32_t sum_cell_counts(const rs_makeup *mk, const float p[3], float r)
 {
     cell_box b;
@@ -1093,6 +1119,7 @@ static int log_cosmetic(rs_makeup *mk, const rs_cosmetic *c)
     mk->cosmetics[mk->cosmetic_count] = *c;
     return (int)mk->cosmetic_count++;
 }
+
 
 static bool finite3(const float v[3]) { return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]); }
 

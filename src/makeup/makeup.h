@@ -189,6 +189,11 @@ rs_result rs_makeup_fine_stamps(const rs_makeup *mk, rs_makeup_fine_stamp **out,
 // Splat nearest to pos within max_dist (model units), through the grid; false when none.
 bool rs_makeup_nearest(const rs_makeup *mk, const float pos[3], float max_dist, uint32_t *idx);
 
+// Calls fn(user, splat, squared distance) for every splat within radius of pos (grid order, each once)
+// until fn returns false. The smudge tool (src/makeup/smudge.c) samples the layer through it.
+typedef bool (*rs_makeup_near_fn)(void *user, uint32_t splat, float dist2);
+void rs_makeup_for_each_near(const rs_makeup *mk, const float pos[3], float radius, rs_makeup_near_fn fn, void *user);
+
 // --- the arithmetic, exposed for tests, the renderer's CPU reference and docs ----------------------
 
 // Brush radius in model units for a size given as a diameter relative to the face height.

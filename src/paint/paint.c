@@ -17,6 +17,7 @@ struct rs_paint {
     rs_input input;
     rs_strokes *rec;
     rs_strokes_view rec_view;
+    rs_smudge smudge;             // the load of a smudge or blend stroke in progress
     bool rec_open;
     int32_t rec_pointer;
     double rec_t0;
@@ -31,6 +32,11 @@ static rs_paint_brush resolve_brush(const rs_paint_brush *b)
     r.size_rel = RS_MIN(r.size_rel, 1.0f);
     r.opacity = RS_MIN(r.opacity, 1.0f);
     if ((unsigned)r.pressure >= RS_MAKEUP_PRESSURE_COUNT) r.pressure = RS_MAKEUP_PRESSURE_FLOOR;
+    if ((unsigned)r.tool >= RS_TOOL_COUNT) r.tool = RS_TOOL_PAINT;
+    // A smudge or blend brush's strength is its own, not the selected product's opacity.
+    if (r.tool != RS_TOOL_PAINT) r.eraser = false, r.opacity = b->opacity > 0.0f && isfinite(b->opacity)
+                                                                  ? RS_MIN(b->opacity, 1.0f)
+                                                                  : RS_SMUDGE_STRENGTH_DEFAULT;
     return r;
 }
 
@@ -110,6 +116,22 @@ static rs_result stamp_at(rs_paint *p, const rs_input_stamp *s, rs_paint_result 
     }
     const rs_splat_cloud *cloud = rs_makeup_cloud(p->mk);
     const rs_paint_brush *b = &p->stroke_brush;
+    rs_makeup_stamp_info info;
+    if (b->tool != RS_TOOL_PAINT) {
+        rs_smudge_stamp_desc sd = {.pos = {pos[0], pos[1], pos[2]},
+                                   .radius = rs_makeup_brush_radius(&cloud->hdr, b->size_rel),
+                                   .strength = b->opacity,
+                                   .pressure = s->pressure,
+                                   .pressure_map = b->pressure,
+                                   .mirror = b->mirror};
+        if (p->picker.view_dir) p->picker.view_dir(p->picker.user, pos, sd.view_dir);
+        rs_result r = rs_smudge_stamp(&p->smudge, p->mk, &sd, &info, err);
+        if (r != RS_OK) return r;
+        merge(&res->dirty, info.dirty);
+        res->stamps++;
+        update_spacing(p, pos);
+        return RS_OK;
+    }
     rs_makeup_stamp_desc d = {
         .pos = {pos[0], pos[1], pos[2]},
         .radius = rs_makeup_brush_radius(&cloud->hdr, b->size_rel),
@@ -122,7 +144,6 @@ static rs_result stamp_at(rs_paint *p, const rs_input_stamp *s, rs_paint_result 
         .region_mask = !b->any_region,
     };
     if (p->picker.view_dir) p->picker.view_dir(p->picker.user, pos, d.view_dir);
-    rs_makeup_stamp_info info;
     rs_result r = rs_makeup_stamp(p->mk, &d, &info, err);
     if (r != RS_OK) return r;
     merge(&res->dirty, info.dirty);
@@ -162,9 +183,11 @@ rs_result rs_paint_feed(rs_paint *p, const rs_input_event *ev, rs_paint_result *
 
     if (out.stroke_begin) {
         rs_makeup_begin_stroke(p->mk);
+        rs_smudge_begin(&p->smudge, p->stroke_brush.tool);
         if (p->rec) {
             rs_strokes_brush sb = {p->stroke_brush.size_rel, p->stroke_brush.opacity, p->stroke_brush.pressure,
-                                   p->stroke_brush.mirror, p->stroke_brush.eraser, p->stroke_brush.any_region};
+                                   p->stroke_brush.mirror, p->stroke_brush.eraser, p->stroke_brush.any_region,
+                                   p->stroke_brush.tool};
             p->rec_open = rs_strokes_begin(p->rec, &p->rec_view, &sb, &p->stroke_brush.cosmetic, NULL) == RS_OK;
             p->rec_pointer = ev->pointer_id;
             p->rec_t0 = ev->time_s;
@@ -210,7 +233,8 @@ rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, u
     rs_strokes *saved_rec = p->rec;
     p->rec = NULL;  // a replay is not something the person did
     p->brush = (rs_paint_brush){st->cosmetic,        st->brush.size_rel, st->brush.opacity, st->brush.pressure,
-                                st->brush.eraser,    st->brush.mirror,   st->brush.any_region};
+                                st->brush.eraser,    st->brush.mirror,   st->brush.any_region,
+                                st->brush.tool};
     rs_input_set_mode(&p->input, RS_INPUT_PAINT);
     double q = rs_paint_radius(p) / rs_makeup_cloud(p->mk)->hdr.face_height;
     float sx = (float)frame_w_px / (float)st->view.width_px, sy = (float)frame_h_px / (float)st->view.height_px;

@@ -20,6 +20,7 @@
 #include "makeup/cosmetics.h"
 #include "paint/input.h"
 #include "makeup/makeup.h"
+#include "makeup/smudge.h"
 #include "formats/strokes.h"
 
 // Implemented by the renderer for the current camera and frame.
@@ -41,6 +42,7 @@ typedef struct rs_paint_brush {
     rs_makeup_pressure pressure;  // how pressure scales opacity
     bool eraser, mirror;
     bool any_region;              // paint anywhere; default: keep to the cosmetic's region (soft-edged)
+    rs_paint_tool tool;           // paint (with or without eraser), smudge or blend (src/makeup/smudge.h)
 } rs_paint_brush;
 
 typedef struct rs_paint_desc {

@@ -272,6 +272,21 @@ static void stage_mark(rs_renderer *r, int stage, double *t)
     *t = now;
 }
 
+void rs_render_set_stage_hook(rs_renderer *r, rs_render_stage_fn fn, void *user)
+{
+    r->stage_hook = fn;
+    r->stage_user = fn ? user : NULL;
+}
+
+// The hook before stage `next` (RS_STAGE_COUNT: the frame is done); RS_OK to go on.
+static rs_result stage_hook(rs_renderer *r, rs_render_stage next, rs_error *err)
+{
+    if (!r->stage_hook) return RS_OK;
+    glFinish();
+    if (r->stage_hook(r->stage_user, next)) return RS_OK;
+    return rs_fail(err, RS_ERR_ARG, "render: stopped");
+}
+
 // The fields a frame depends on (padding aside, which a caller's struct may leave undefined).
 static bool same_view(const rs_view *a, const rs_view *b)
 {
@@ -392,22 +407,28 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
         return res;
     }
     stage_mark(r, -1, &t);
-    if (f.shadows) res = rs_render_shadow(r, &f, err);
+    res = stage_hook(r, RS_STAGE_SHADOW, err);
+    if (res == RS_OK && f.shadows) res = rs_render_shadow(r, &f, err);
     stage_mark(r, RS_STAGE_SHADOW, &t);
+    if (res == RS_OK) res = stage_hook(r, RS_STAGE_VISIBILITY, err);
     if (res == RS_OK) res = rs_render_visibility(r, &f, err);
     stage_mark(r, RS_STAGE_VISIBILITY, &t);
+    if (res == RS_OK) res = stage_hook(r, RS_STAGE_ATTRIBUTE, err);
     if (res == RS_OK) res = rs_render_attributes(r, &f, err);
     stage_mark(r, RS_STAGE_ATTRIBUTE, &t);
     rs_diffusion_level levels[RS_PROFILE_MAX];
     int nlevels = 0;
     r->stats.diffusion_splats = 0;
+    if (res == RS_OK) res = stage_hook(r, RS_STAGE_DIFFUSION, err);
     if (res == RS_OK && f.diffuse) {
         nlevels = rs_render_diffusion_plan(r, &f, levels, f.delta_weight);
         res = rs_render_diffusion(r, &f, levels, nlevels, err);
     }
     stage_mark(r, RS_STAGE_DIFFUSION, &t);
+    if (res == RS_OK) res = stage_hook(r, RS_STAGE_COMPOSITE, err);
     if (res == RS_OK) res = rs_render_composite(r, &f, err);
     stage_mark(r, RS_STAGE_COMPOSITE, &t);
+    if (res == RS_OK) res = stage_hook(r, RS_STAGE_COUNT, err);
 
     // Leave the caller's GL state as it was where it would surprise: blend, depth, viewport, FBO.
     glDisable(GL_BLEND);

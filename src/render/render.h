@@ -153,6 +153,14 @@ void rs_render_destroy(rs_renderer *r);
 
 // Renders into the renderer's output texture (resized to the view as needed).
 rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err);
+// A hook called as a full frame (not an incremental one) begins each of its stages, and once more with
+// RS_STAGE_COUNT when the frame is done. A first frame's stages also compile their shaders and make the
+// shadow map: seconds on a software GPU, which a loading screen wants to show. The GL work queued so far
+// is finished before each call (so the call sees real progress). Returning false stops the frame there:
+// rs_render_frame fails with RS_ERR_ARG "render: stopped" and the last complete frame stays the last.
+// NULL removes the hook.
+typedef bool (*rs_render_stage_fn)(void *user, rs_render_stage next);
+void rs_render_set_stage_hook(rs_renderer *r, rs_render_stage_fn fn, void *user);
 // The RGBA8 output texture of the last frame (for the viewer to draw), and its size.
 GLuint rs_render_output_texture(const rs_renderer *r, int *width, int *height);
 // Reads the last frame back into a new RGBA image (rows top-first).

@@ -157,7 +157,7 @@ rs_result rs_render_update_fine(rs_renderer *r, const rs_makeup_fine_stamp *s, u
         upload_rows(g->data_tex, GL_RGBA, GL_FLOAT, data, data_texels, 16);
         upload_rows(g->index_tex, GL_RED_INTEGER, GL_UNSIGNED_INT, index, index_texels, 4);
     }
-    memcpy(copy, s, (size_t)n * sizeof *s);
+    if (n) memcpy(copy, s, (size_t)n * sizeof *s);  // s is NULL when the layer has no fine stamps
     free(g->last);
     g->last = copy;
     g->last_count = n;

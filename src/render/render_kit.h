@@ -173,6 +173,8 @@ struct rs_renderer {
     rs_gl_caps caps;
     bool float_rt;
     bool time_stages;
+    rs_render_stage_fn stage_hook;  // rs_render_set_stage_hook
+    void *stage_user;
     float radius_median;        // model units, full cloud
     float bound_centre[3], bound_radius;  // bounding sphere of the quantization box
 

@@ -377,6 +377,44 @@ if (main?.state === 'ready') {
               s.events - before.events === n && got === n && s.lookStamps > before.lookStamps && !s.inStroke,
               `${got} of ${n} events applied over ${frames} frames of 700 ms, ${s.lookStamps - before.lookStamps} stamps`);
     });
+
+    await run('the smudge tool drags the lipstick off the lips', async () => {
+        if (!lips) {  // run alone (WEB_ONLY): the lipstick first, along the lips' widest row
+            lips = await lipsMask(page);
+            if (!lips) throw new Error('no lips pixel found by picking');
+            let best = -1, bestN = 0;
+            for (let y = 0; y < lips.height; y++) {
+                let k = 0;
+                for (let x = 0; x < lips.width; x++) k += lips.mask[y * lips.width + x];
+                if (k > bestN) bestN = k, best = y;
+            }
+            let x0 = lips.width, x1 = 0;
+            for (let x = 0; x < lips.width; x++) if (lips.mask[best * lips.width + x]) x0 = Math.min(x0, x), x1 = Math.max(x1, x);
+            await page.evaluate(() => window.rouge.setBrush({ cosmetic: 'lipstick_satin' }));
+            await touchStroke(cdp, line(x0, best, x1, best, 16));
+            await settle(page);
+        }
+        const bad = await page.evaluate(() => window.rouge.setBrush({ tool: 'rub' }).then(() => 'accepted', (e) => e.message));
+        await page.evaluate(() => window.rouge.setBrush({ tool: 'smudge', size: 0.05 }));
+        const { mask, width: w, height: h } = lips;
+        // From the middle of the lips straight down, past the lower lip onto the chin.
+        let sx = 0, sy = 0, n = 0;
+        for (let y = 0; y < h; y++) for (let x = 0; x < w; x++) if (mask[y * w + x]) sx += x, sy += y, n++;
+        const cx = Math.round(sx / n), cy = Math.round(sy / n);
+        let bottom = cy;
+        for (let y = cy; y < h; y++) if (mask[y * w + cx]) bottom = y;
+        const before = await pixels(page);
+        await touchStroke(cdp, line(cx, cy, cx, Math.min(h - 2, bottom + 18), 12));
+        await settle(page);
+        const after = await pixels(page);
+        await page.evaluate(() => window.rouge.setBrush({ tool: 'paint' }));
+        const near = dilate(mask, w, h, 2);
+        let outside = 0;
+        for (let i = 0; i < mask.length; i++) if (!near[i] && changed(before, after, i * 4)) outside++;
+        await savePng(page, after, 'web_smudge.png');
+        check('the smudge tool drags the lipstick off the lips', outside >= 15 && /brush\.tool "rub"/.test(bad),
+              `${outside} pixels below the lips changed; tool "rub": ${bad}`);
+    });
     await page.close();
 }
 
