@@ -320,7 +320,7 @@ envs: deps $(BUILD)/rouge-env
 	$(BUILD)/rouge-env $(ENV_SRC)/interior.exr -o assets/env/office.rse --name office --notes "$(call ENV_NOTE,,interior)"
 	$(BUILD)/rouge-env $(ENV_SRC)/sunset.exr -o assets/env/sunset.rse --name sunset --notes "$(call ENV_NOTE,,sunset)"
 
-# The path-traced reference (tools/truth/README.md): Debian's Blender renders the scan face.rsf was made from
+# The path-traced reference (tests/fixtures/truth/README.md): Debian's Blender renders the scan face.rsf was made from
 # (../shared/data/leeperrysmith) under every bundled environment; tests/test_truth.c compares rouge to it.
 # Slow (minutes of CPU a view); not part of make test. truth-deps installs Blender (and numpy for its Python).
 truth-deps: deps

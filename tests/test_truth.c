@@ -1,6 +1,6 @@
 // test_truth.c — rouge against the path tracer (issue 22): the bundled face in the reference pipeline under
 // every bundled environment, from the views of tests/fixtures/truth/ (Blender Cycles renders of the scan
-// face.rsf was made from, at rouge's own camera; tools/truth/, `make truth`; what differs: the README there).
+// face.rsf was made from, at rouge's own camera; tools/truth/, `make truth`; what differs: tests/fixtures/truth/README.md).
 //
 // Per view, at matched exposure (the one factor k on the path tracer's radiance that makes the median ratio of
 // rouge's scene-linear luminance to its own over the face 1; rouge's frame is taken back through its sRGB

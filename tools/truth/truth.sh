@@ -1,5 +1,5 @@
 #!/bin/sh
-# make truth: the path-traced reference of the bundled head (tools/truth/README.md). Renders every bundled
+# make truth: the path-traced reference of the bundled head (tests/fixtures/truth/README.md). Renders every bundled
 # environment x view with Blender Cycles and writes tests/fixtures/truth/ENV_VIEW.rtf.zst. Slow (about
 # TRUTH_SAMPLES x 0.3 s of CPU a view); never part of make test.
 #   sh tools/truth/truth.sh BUILD_DIR        TRUTH_SAMPLES (512), TRUTH_ENVS ("studio daylight office sunset")
