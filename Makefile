@@ -52,8 +52,9 @@ SOMAJOR  := 0
 SONAME   := librouge.so.$(SOMAJOR)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 
-.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall import-fixtures web web-deps
-all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES)
+.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall import-fixtures web web-deps truth \
+        truth-deps
+all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES) $(BUILD)/rouge-truth-scene
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
 deps:
@@ -130,6 +131,12 @@ $(BUILD)/obj/tools/env/exr_read.o: tools/env/exr_read.cpp tools/env/exr_read.h
 	$(CXX) -std=c++17 $(OPT) -g -Wall -Wextra -Werror $(EXTRA_CFLAGS) $(shell pkg-config --cflags OpenEXR) -c $< -o $@
 $(BUILD)/rouge-env: $(ENV_TOOL_OBJ) $(BUILD)/librouge.a
 	$(CXX) $(OPT) -g $(EXTRA_CFLAGS) $^ $(PKG_LIBS) $(shell pkg-config --libs OpenEXR) -lm $(LDFLAGS) -o $@
+
+# rouge-truth-scene (tools/truth/: the path-traced reference's inputs) reads the same HDRIs as rouge-env.
+TRUTH_SCENE_OBJ := $(BUILD)/obj/tools/truth/truth_scene.o $(ENV_BAKE_OBJ) $(BUILD)/obj/tools/env/env_read.o \
+                   $(BUILD)/obj/tools/env/exr_read.o
+$(BUILD)/rouge-truth-scene: $(TRUTH_SCENE_OBJ) $(BUILD)/librouge.a
+	$(CXX) $(OPT) -g $(EXTRA_CFLAGS) $^ $(PKG_LIBS) $(shell pkg-config --libs OpenEXR) -lm -pthread $(LDFLAGS) -o $@
 
 $(BUILD)/rouge-%: $(BUILD)/obj/tools/rouge_%.o $(BUILD)/librouge.a
 	$(CC) $(CFLAGS) $< $(LIBS) $(LDFLAGS) -o $@
@@ -312,6 +319,15 @@ envs: deps $(BUILD)/rouge-env
 	$(BUILD)/rouge-env $(ENV_SRC)/city.exr -o assets/env/daylight.rse --name daylight --notes "$(call ENV_NOTE,,city)"
 	$(BUILD)/rouge-env $(ENV_SRC)/interior.exr -o assets/env/office.rse --name office --notes "$(call ENV_NOTE,,interior)"
 	$(BUILD)/rouge-env $(ENV_SRC)/sunset.exr -o assets/env/sunset.rse --name sunset --notes "$(call ENV_NOTE,,sunset)"
+
+# The path-traced reference (tests/fixtures/truth/README.md): Debian's Blender renders the scan face.rsf was made from
+# (../shared/data/leeperrysmith) under every bundled environment; tests/test_truth.c compares rouge to it.
+# Slow (minutes of CPU a view); not part of make test. truth-deps installs Blender (and numpy for its Python).
+truth-deps: deps
+	@sh tools/deps.sh truth
+
+truth: truth-deps $(BUILD)/rouge-truth-scene
+	@sh tools/truth/truth.sh $(BUILD)
 
 clean:
 	rm -rf build build-*

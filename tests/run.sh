@@ -17,7 +17,7 @@ jobs=${RS_TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 alone="$build/tests/test_atomic_save"
 # The slow ones (minutes on 2 cores) first; then the rest in name order.
 slow="tests/test_valgrind.sh tests/test_web.sh tests/test_viewer.sh $build/tests/test_mobile tests/test_env_tool.sh
-      $build/tests/test_import $build/tests/test_render $build/tests/test_edges"
+      $build/tests/test_import $build/tests/test_render $build/tests/test_edges $build/tests/test_truth"
 all=""
 for t in "$build"/tests/test_* tests/test_*.sh; do
     [ -f "$t" ] || continue

@@ -23,6 +23,12 @@ for pkg in libegl-mesa0 libgl1-mesa-dri xvfb xauth xdotool blender-data; do
     dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed' || need "$pkg"
 done
 
+if [ "${1:-}" = truth ]; then
+    for pkg in blender python3-numpy zstd; do
+        dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed' || need "$pkg"
+    done
+fi
+
 [ -z "$missing" ] && exit 0
 
 if ! command -v apt-get >/dev/null 2>&1; then

@@ -1,0 +1,430 @@
+// test_truth.c — rouge against the path tracer (issue 22): the bundled face in the reference pipeline under
+// every bundled environment, from the views of tests/fixtures/truth/ (Blender Cycles renders of the scan
+// face.rsf was made from, at rouge's own camera; tools/truth/, `make truth`; what differs: tests/fixtures/truth/README.md).
+//
+// Per view, at matched exposure (the one factor k on the path tracer's radiance that makes the median ratio of
+// rouge's scene-linear luminance to its own over the face 1; rouge's frame is taken back through its sRGB
+// encoding and tone curve, the path tracer's goes forward through them):
+//   - mean CIEDE2000 over the face, both images blurred by a Gaussian of sigma 1 px;
+//   - path tracer / rouge mean scene-linear luminance under the chin, on the lips, ears, nose, eye sockets
+//     (the fixture's label plane: .rsf regions of the nearest splat, ears and under-chin by geometry);
+//   - rouge / path tracer mean luminance of the contour band (3 px inside the silhouette and on the near side
+//     of depth steps over 10 mm: where rouge drew dark outlines).
+// Issue 22's goals: mean dE <= 2.0, every ratio within [0.87, 1.15], the band no darker (>= 1). Where a goal
+// is not met the test guards the number measured when the fixtures were made (the `was` table) against
+// regressions and reports the goal as a skip. Also checked: the silhouettes agree (IoU) and rouge's albedo
+// view matches the path tracer's albedo, so a mismatch there is not mistaken for lighting.
+// rouge | path tracer | dE map PNGs go to the test output folder (truth_ENV_VIEW.png).
+#include "support/harness.h"
+#include "gl/gl.h"
+#include "rouge.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <zstd.h>
+
+#define FACE "assets/face.rsf"
+#define FIXTURES "tests/fixtures/truth"
+#define HEADER 68
+// Label plane values (tools/truth/render.py).
+#define LABEL_REGION0 1
+#define LABEL_EARS 16
+#define LABEL_UNDER_CHIN 17
+#define LABEL_CONTOUR 128
+#define REGION_NOSE 2
+#define REGION_LIPS 4
+#define REGION_EYELID 5
+
+enum { R_CHIN, R_LIPS, R_EARS, R_NOSE, R_EYES, R_COUNT };
+static const char *region_names[R_COUNT] = {"under chin", "lips", "ears", "nose", "eye sockets"};
+
+// What was measured when the fixtures were made (rouge as of this test's commit): the regression guards.
+typedef struct measured {
+    const char *env, *view;
+    double delta_e, ratio[R_COUNT], band;
+} measured;
+static const measured was[] = {
+    {"studio", "front", 2.31, {1.130, 1.072, 1.067, 1.057, 1.038}, 0.751},
+    {"studio", "threequarter", 3.35, {1.194, 1.101, 1.069, 1.055, 1.028}, 0.825},
+    {"daylight", "front", 2.11, {1.073, 1.038, 1.056, 1.041, 1.094}, 0.856},
+    {"daylight", "threequarter", 2.06, {1.078, 1.052, 0.979, 1.042, 1.063}, 0.872},
+    {"office", "front", 2.95, {1.090, 0.999, 1.094, 0.954, 1.119}, 0.802},
+    {"office", "threequarter", 2.51, {1.087, 1.029, 1.109, 1.011, 1.118}, 0.836},
+    {"sunset", "front", 2.40, {1.132, 1.107, 1.105, 1.073, 1.189}, 0.837},
+    {"sunset", "threequarter", 2.31, {1.124, 1.143, 1.005, 1.073, 1.169}, 0.848},
+};
+#define GOAL_DELTA_E 2.0
+#define GOAL_RATIO_LO 0.87
+#define GOAL_RATIO_HI 1.15
+#define GOAL_BAND 1.0
+
+static rs_gl_context *gl;
+static rouge_face *face;
+static int current;  // index into `was` of the view under test
+
+typedef struct truth {
+    int w, h;
+    float yaw, pitch;
+    float *rgb, *albedo;  // linear, w * h * 3, rows from the top
+    uint8_t *alpha, *label;
+} truth;
+
+static float half_to_float(uint16_t h)
+{
+    int s = h >> 15, e = (h >> 10) & 31, m = h & 1023;
+    float v = e == 0 ? ldexpf((float)m, -24) : e == 31 ? INFINITY : ldexpf((float)(m | 1024), e - 25);
+    return s ? -v : v;
+}
+
+static void truth_free(truth *t)
+{
+    free(t->rgb), free(t->albedo), free(t->alpha), free(t->label);
+    memset(t, 0, sizeof *t);
+}
+
+static bool truth_load(const char *env, const char *view, truth *t)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/%s_%s.rtf.zst", FIXTURES, env, view);
+    void *z = NULL;
+    size_t zlen = 0;
+    rs_error err = {0};
+    if (!RS_CHECK(rs_file_read_all(path, 64u << 20, &z, &zlen, &err) == RS_OK, "%s", err.msg)) return false;
+    unsigned long long n = ZSTD_getFrameContentSize(z, zlen);
+    bool ok = RS_CHECK(n != ZSTD_CONTENTSIZE_ERROR && n != ZSTD_CONTENTSIZE_UNKNOWN && n > HEADER && n < (64u << 20),
+                       "%s: not a zstd frame of known size", path);
+    uint8_t *d = ok ? malloc(n) : NULL;
+    ok = ok && d && RS_CHECK(ZSTD_decompress(d, n, z, zlen) == n, "%s: damaged", path);
+    free(z);
+    if (!ok) {
+        free(d);
+        return false;
+    }
+    uint32_t w, h;
+    memcpy(&w, d + 8, 4), memcpy(&h, d + 12, 4);
+    size_t px = (size_t)w * h;
+    ok = RS_CHECK(memcmp(d, "RSTRUTH1", 8) == 0 && w >= 16 && w <= 2048 && h >= 16 && h <= 2048 &&
+                      n == HEADER + px * (6 + 6 + 1 + 1),
+                  "%s: not a truth fixture (tools/truth/render.py)", path);
+    if (ok) {
+        t->w = (int)w, t->h = (int)h;
+        memcpy(&t->yaw, d + 48, 4), memcpy(&t->pitch, d + 52, 4);
+        t->rgb = malloc(px * 3 * sizeof(float));
+        t->albedo = malloc(px * 3 * sizeof(float));
+        t->alpha = malloc(px);
+        t->label = malloc(px);
+        ok = t->rgb && t->albedo && t->alpha && t->label;
+    }
+    if (ok) {
+        const uint8_t *p = d + HEADER;
+        for (size_t i = 0; i < px * 3; i++) {
+            uint16_t a, b;
+            memcpy(&a, p + 2 * i, 2), memcpy(&b, p + px * 6 + 2 * i, 2);
+            t->rgb[i] = half_to_float(a), t->albedo[i] = half_to_float(b);
+        }
+        memcpy(t->alpha, p + px * 12, px);
+        memcpy(t->label, p + px * 13, px);
+    }
+    free(d);
+    if (!ok) truth_free(t);
+    return ok;
+}
+
+static bool render(const rouge_view *v, uint8_t *rgba)
+{
+    rouge_error e = {0};
+    if (!RS_CHECK(rouge_face_set_view(face, v, &e) == ROUGE_OK, "view: %s", e.msg)) return false;
+    if (!RS_CHECK(rouge_face_render(face, &e) == ROUGE_OK, "render: %s", e.msg)) return false;
+    return RS_CHECK(rouge_face_read_rgba(face, rgba, (size_t)v->width * v->height * 4, &e) == ROUGE_OK, "read: %s",
+                    e.msg);
+}
+
+// rouge's tone curve (composite.frag.glsl: the ACES fit of Narkowicz 2015) and its inverse.
+static double filmic(double x)
+{
+    x = fmax(x, 0.0);
+    return fmin(fmax(x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14), 0.0), 1.0);
+}
+
+static double filmic_inverse(double y)
+{
+    // (2.43 y - 2.51) x^2 + (0.59 y - 0.03) x + 0.14 y = 0, the root >= 0 (y below the curve's limit 1.033).
+    y = fmin(fmax(y, 0.0), 0.995);
+    double a = 2.43 * y - 2.51, b = 0.59 * y - 0.03, c = 0.14 * y;
+    return (-b - sqrt(b * b - 4 * a * c)) / (2 * a);
+}
+
+static double srgb_decode(double c) { return c <= 0.04045 ? c / 12.92 : pow((c + 0.055) / 1.055, 2.4); }
+static double srgb_encode(double c)
+{
+    c = fmin(fmax(c, 0.0), 1.0);
+    return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+
+static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+// Display-encoded sRGB (0..1) -> CIELAB, D65.
+static void srgb_to_lab(const double s[3], double lab[3])
+{
+    double r = srgb_decode(s[0]), g = srgb_decode(s[1]), b = srgb_decode(s[2]);
+    double xyz[3] = {(0.4124 * r + 0.3576 * g + 0.1805 * b) / 0.95047, 0.2126 * r + 0.7152 * g + 0.0722 * b,
+                     (0.0193 * r + 0.1192 * g + 0.9505 * b) / 1.08883};
+    double f[3];
+    for (int k = 0; k < 3; k++)
+        f[k] = xyz[k] > 216.0 / 24389.0 ? cbrt(xyz[k]) : (24389.0 / 27.0 * xyz[k] + 16.0) / 116.0;
+    lab[0] = 116.0 * f[1] - 16.0, lab[1] = 500.0 * (f[0] - f[1]), lab[2] = 200.0 * (f[1] - f[2]);
+}
+
+// Gaussian blur (sigma 1 px, radius 3) of a 3-channel image over the mask only: normalised convolution, so
+// the background never bleeds into the face.
+static void blur_masked(const double *in, const uint8_t *mask, int w, int h, double *out)
+{
+    double k[7], *tmp = calloc((size_t)w * h * 4, sizeof(double));
+    for (int i = -3; i <= 3; i++) k[i + 3] = exp(-0.5 * i * i);
+    if (!tmp) return;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double acc[4] = {0};
+            for (int i = -3; i <= 3; i++) {
+                int xx = x + i;
+                if (xx < 0 || xx >= w || !mask[(size_t)y * w + xx]) continue;
+                for (int c = 0; c < 3; c++) acc[c] += k[i + 3] * in[((size_t)y * w + xx) * 3 + c];
+                acc[3] += k[i + 3];
+            }
+            memcpy(tmp + ((size_t)y * w + x) * 4, acc, sizeof acc);
+        }
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double acc[4] = {0};
+            for (int i = -3; i <= 3; i++) {
+                int yy = y + i;
+                if (yy < 0 || yy >= h) continue;
+                const double *t = tmp + ((size_t)yy * w + x) * 4;
+                for (int c = 0; c < 4; c++) acc[c] += k[i + 3] * t[c];
+            }
+            for (int c = 0; c < 3; c++) out[((size_t)y * w + x) * 3 + c] = acc[3] > 0 ? acc[c] / acc[3] : 0.0;
+        }
+    free(tmp);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+// dE 0 black, 5 red, 10 yellow, 15 and over white.
+static void heat(double de, uint8_t *p)
+{
+    double t = fmin(de / 15.0, 1.0) * 3.0;
+    p[0] = (uint8_t)lround(255 * fmin(t, 1.0));
+    p[1] = (uint8_t)lround(255 * fmin(fmax(t - 1.0, 0.0), 1.0));
+    p[2] = (uint8_t)lround(255 * fmin(fmax(t - 2.0, 0.0), 1.0));
+}
+
+typedef struct result {
+    double k, iou, albedo_diff, delta_e, ratio[R_COUNT], band;
+    int region_px[R_COUNT], band_px;
+} result;
+
+static int region_of(uint8_t label)
+{
+    int l = label & (LABEL_CONTOUR - 1);
+    if (l == LABEL_UNDER_CHIN) return R_CHIN;
+    if (l == LABEL_EARS) return R_EARS;
+    if (l == LABEL_REGION0 + REGION_LIPS) return R_LIPS;
+    if (l == LABEL_REGION0 + REGION_NOSE) return R_NOSE;
+    if (l == LABEL_REGION0 + REGION_EYELID) return R_EYES;
+    return -1;
+}
+
+// Renders rouge at the fixture's view and measures everything in `result`. false: a check failed.
+static bool measure(const char *env, const truth *t, result *res, const char *png_name)
+{
+    int w = t->w, h = t->h;
+    size_t n = (size_t)w * h;
+    uint8_t *img = malloc(n * 4), *alb = malloc(n * 4), *mask = calloc(n, 1), *face_px = calloc(n, 1);
+    double *ro = malloc(n * 3 * sizeof(double)), *pt = malloc(n * 3 * sizeof(double));
+    double *rb = malloc(n * 3 * sizeof(double)), *pb = malloc(n * 3 * sizeof(double));
+    double *ratio = malloc(n * sizeof(double)), *de = calloc(n, sizeof(double));
+    bool ok = RS_CHECK(img && alb && mask && face_px && ro && pt && rb && pb && ratio && de, "out of memory");
+    rouge_view v = {.width = w, .height = h, .yaw_deg = t->yaw, .pitch_deg = t->pitch, .env = env,
+                    .pipeline = ROUGE_PIPELINE_REFERENCE, .background = {0, 0, 0, 1}};
+    ok = ok && render(&v, img);
+    // The albedo view does not depend on the environment: checked once per view (under studio).
+    bool check_albedo = strcmp(env, "studio") == 0;
+    v.mode = ROUGE_MODE_ALBEDO;
+    ok = ok && (!check_albedo || render(&v, alb));
+    if (!ok) goto out;
+    // Silhouettes: rouge's face is every pixel not the exact background; the reference's its alpha.
+    size_t inter = 0, uni = 0;
+    for (size_t i = 0; i < n; i++) {
+        const uint8_t *p = img + i * 4;
+        face_px[i] = p[0] | p[1] | p[2];
+        bool a = face_px[i], b = t->alpha[i] >= 128;
+        inter += a && b, uni += a || b;
+    }
+    res->iou = uni ? (double)inter / uni : 0.0;
+    // The measured face: both cover the pixel fully, 2 px from any edge of the reference's coverage.
+    for (int y = 2; y < h - 2; y++)
+        for (int x = 2; x < w - 2; x++) {
+            bool in = true;
+            for (int dy = -2; dy <= 2 && in; dy++)
+                for (int dx = -2; dx <= 2 && in; dx++) in = t->alpha[(size_t)(y + dy) * w + x + dx] == 255;
+            size_t i = (size_t)y * w + x;
+            mask[i] = in && face_px[i];
+        }
+    // Scene-linear rouge (back through sRGB and the tone curve) and the exposure factor k.
+    size_t m = 0;
+    double alb_sum = 0;
+    size_t alb_n = 0;
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++) ro[i * 3 + c] = filmic_inverse(srgb_decode(img[i * 4 + c] / 255.0));
+        if (!mask[i]) continue;
+        const uint8_t *p = img + i * 4;
+        double lr = lum(ro + i * 3), tp[3] = {t->rgb[i * 3], t->rgb[i * 3 + 1], t->rgb[i * 3 + 2]}, lp = lum(tp);
+        if (p[0] < 250 && p[1] < 250 && p[2] < 250 && lp > 1e-4) ratio[m++] = lr / lp;
+        for (int c = 0; c < 3 && check_albedo; c++)
+            alb_sum += fabs(alb[i * 4 + c] / 255.0 - srgb_encode(t->albedo[i * 3 + c])), alb_n++;
+    }
+    if (!RS_CHECK(m > n / 10, "only %zu face pixels to compare", m)) {
+        ok = false;
+        goto out;
+    }
+    res->albedo_diff = alb_n ? alb_sum / (double)alb_n : -1.0;
+    qsort(ratio, m, sizeof *ratio, cmp_double);
+    res->k = ratio[m / 2];
+    // Displayed images (0..1 sRGB): rouge's as read, the path tracer's through the same curve at k.
+    for (size_t i = 0; i < n; i++)
+        for (int c = 0; c < 3; c++) {
+            rb[i * 3 + c] = img[i * 4 + c] / 255.0;
+            pt[i * 3 + c] = res->k * t->rgb[i * 3 + c];
+            pb[i * 3 + c] = srgb_encode(filmic(pt[i * 3 + c]));
+        }
+    double *rblur = malloc(n * 3 * sizeof(double)), *pblur = malloc(n * 3 * sizeof(double));
+    if (!RS_CHECK(rblur && pblur, "out of memory")) {
+        free(rblur), free(pblur);
+        ok = false;
+        goto out;
+    }
+    blur_masked(rb, mask, w, h, rblur);
+    blur_masked(pb, mask, w, h, pblur);
+    double de_sum = 0;
+    size_t de_n = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!mask[i]) continue;
+        double la[3], lb[3];
+        srgb_to_lab(rblur + i * 3, la);
+        srgb_to_lab(pblur + i * 3, lb);
+        de[i] = rs_ciede2000(la, lb);
+        de_sum += de[i], de_n++;
+    }
+    free(rblur), free(pblur);
+    res->delta_e = de_sum / (double)de_n;
+    // Region and contour luminance.
+    double reg[R_COUNT][2] = {{0}}, band[2] = {0};
+    memset(res->region_px, 0, sizeof res->region_px);
+    res->band_px = 0;
+    for (size_t i = 0; i < n; i++) {
+        int r = region_of(t->label[i]);
+        if (r >= 0 && mask[i]) {
+            reg[r][0] += lum(pt + i * 3), reg[r][1] += lum(ro + i * 3);
+            res->region_px[r]++;
+        }
+        if ((t->label[i] & LABEL_CONTOUR) && t->alpha[i] == 255 && face_px[i]) {
+            band[0] += lum(ro + i * 3), band[1] += lum(pt + i * 3);
+            res->band_px++;
+        }
+    }
+    for (int r = 0; r < R_COUNT; r++) res->ratio[r] = reg[r][1] > 0 ? reg[r][0] / reg[r][1] : 0.0;
+    res->band = band[1] > 0 ? band[0] / band[1] : 0.0;
+    // rouge | path tracer | dE (both over black).
+    rs_image side = {0};
+    if (rs_image_create(3 * w, h, 3, &side, NULL) == RS_OK) {
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                size_t i = (size_t)y * w + x;
+                uint8_t *o = side.pixels + ((size_t)y * 3 * w + x) * 3;
+                double a = t->alpha[i] / 255.0;
+                for (int c = 0; c < 3; c++) {
+                    o[c] = img[i * 4 + c];
+                    o[3 * w + c] = (uint8_t)lround(255 * pb[i * 3 + c] * a);
+                }
+                heat(mask[i] ? de[i] : 0.0, o + 6 * w);
+            }
+        rs_test_save(png_name, &side);
+        rs_image_free(&side);
+    }
+out:
+    free(img), free(alb), free(mask), free(face_px), free(ro), free(pt), free(rb), free(pb), free(ratio), free(de);
+    return ok;
+}
+
+static double outside(double r) { return r < GOAL_RATIO_LO ? GOAL_RATIO_LO - r : r > GOAL_RATIO_HI ? r - GOAL_RATIO_HI : 0; }
+
+static void test_view(void)
+{
+    const measured *ref = &was[current];
+    truth t = {0};
+    if (!truth_load(ref->env, ref->view, &t)) return;
+    result r = {0};
+    char png[64];
+    snprintf(png, sizeof png, "truth_%s_%s", ref->env, ref->view);
+    bool ok = measure(ref->env, &t, &r, png);
+    truth_free(&t);
+    if (!ok) return;
+    printf("# truth %s %s: k %.3f, silhouette IoU %.4f, albedo |diff| %.4f, mean dE2000 %.2f; path tracer / rouge:",
+           ref->env, ref->view, r.k, r.iou, r.albedo_diff, r.delta_e);
+    for (int i = 0; i < R_COUNT; i++)
+        if (r.region_px[i] >= 20) printf(" %s %.3f", region_names[i], r.ratio[i]);
+    printf("; contour band rouge / path tracer %.3f (%d px)\n", r.band, r.band_px);
+    // The fixture is the scene rouge renders: same camera and outline, same albedo.
+    RS_CHECK(r.iou >= 0.98, "silhouettes differ: IoU %.4f", r.iou);
+    // albedo_diff -1: not checked under this environment.
+    RS_CHECK(r.albedo_diff <= 0.03, "albedo differs by %.4f (mean |sRGB| difference)", r.albedo_diff);
+    RS_CHECK(r.k > 0.5 && r.k < 2.0, "exposure factor %.3f: the fixture is not at rouge's scale", r.k);
+    bool goal = r.delta_e <= GOAL_DELTA_E && r.band >= GOAL_BAND, held = true;
+    char unmet[512] = "";
+    size_t len = 0;
+    if (r.delta_e > GOAL_DELTA_E) len += snprintf(unmet + len, sizeof unmet - len, " dE %.2f (goal <= 2.0)", r.delta_e);
+    held &= RS_CHECK(r.delta_e <= fmax(GOAL_DELTA_E, ref->delta_e + 0.25), "mean dE %.2f (was %.2f)", r.delta_e,
+                     ref->delta_e);
+    for (int i = 0; i < R_COUNT; i++) {
+        if (r.region_px[i] < 20) continue;  // not in view
+        if (outside(r.ratio[i]) > 0) {
+            goal = false;
+            len += snprintf(unmet + len, sizeof unmet - len, " %s %.3f", region_names[i], r.ratio[i]);
+        }
+        held &= RS_CHECK(outside(r.ratio[i]) <= outside(ref->ratio[i]) + 0.05, "%s: %.3f (was %.3f)",
+                         region_names[i], r.ratio[i], ref->ratio[i]);
+    }
+    if (r.band < GOAL_BAND) len += snprintf(unmet + len, sizeof unmet - len, " contour band %.3f (goal >= 1)", r.band);
+    held &= RS_CHECK(r.band >= fmin(GOAL_BAND, ref->band - 0.03), "contour band %.3f (was %.3f)", r.band, ref->band);
+    if (!goal && held) rs_test_skip("issue 22's goal not met yet (%s %s):%s", ref->env, ref->view, unmet);
+}
+
+int main(int argc, char **argv)
+{
+    rs_test_init(argc, argv);
+    rs_error err = {0};
+    if (rs_gl_create(&(rs_gl_desc){0}, &gl, &err) != RS_OK) {
+        printf("skip - truth: no GLES 3 context (%s)\n", err.msg);
+        return rs_test_finish();
+    }
+    rouge_error e = {0};
+    if (rouge_face_create(&(rouge_face_desc){.path = FACE}, &face, &e) != ROUGE_OK) {
+        printf("FAIL - truth: %s\n", e.msg);
+        rs_gl_destroy(gl);
+        return 1;
+    }
+    for (current = 0; current < (int)(sizeof was / sizeof was[0]); current++) {
+        char name[64];
+        snprintf(name, sizeof name, "truth_%s_%s", was[current].env, was[current].view);
+        rs_test_run(name, test_view);
+    }
+    rouge_face_destroy(face);
+    rs_gl_destroy(gl);
+    return rs_test_finish();
+}
