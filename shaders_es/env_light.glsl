@@ -6,6 +6,8 @@
 uniform float u_env_on;             // 0: no environment (key/fill/ambient only)
 uniform mat3 u_env_from_view;
 uniform vec3 u_env_sh[9];           // irradiance / pi, times the environment's exposure normalisation
+uniform vec3 u_env_lamp_dir[3];     // the other compact lamps (render_env.c find_lamps): taken out of the
+uniform vec3 u_env_lamp_color[3];   // SH, lit exactly (unshadowed, diffuse only); colour 0 when unused
 uniform highp sampler2D u_env_map;  // RGB9E5 equirect, level k prefiltered with roughness u_env_m[k]
 uniform float u_env_m[8];
 uniform int u_env_levels;
@@ -21,6 +23,7 @@ vec3 rs_env_irradiance(vec3 n_view)
            + u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
            + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
            + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y));
+    for (int i = 0; i < 3; i++) e += u_env_lamp_color[i] * max(dot(n, u_env_lamp_dir[i]), 0.0);
     return max(e, vec3(0.0));
 }
 
