@@ -23,7 +23,7 @@
 #define MM_PER_UNIT 47.0f
 #define SPHERE_MM 20.0f
 #define SKIN_M 0.265f      // the default "other" region's roughness (Weyrich's mean)
-#define EXACT_WIDTH 512    // the capture is integrated at this width (0.7 deg texels; the lobe is ~15 deg)
+#define EXACT_WIDTH 256    // the capture is integrated at this width (1.4 deg texels, power kept; the lobe is ~15 deg)
 #define BANDS 5
 #define PER_BAND 80        // pixels integrated exactly per band
 
