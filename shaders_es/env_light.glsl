@@ -38,13 +38,12 @@ float rs_env_lod(float m)
     return float(u_env_levels - 1);
 }
 
-// Radiance around view-space direction r, prefiltered for roughness m.
-vec3 rs_env_radiance(vec3 r_view, float m)
+// Radiance around the environment-frame unit direction d, from the map's (fractional) level lod.
+vec3 rs_env_radiance(vec3 d, float lod)
 {
-    vec3 d = normalize(u_env_from_view * r_view);
     // docs/env.md: phi = atan(x, z) from forward towards the subject's left, theta from up.
     vec2 uv = vec2(atan(d.x, d.z) * 0.15915494 + 0.5, acos(clamp(d.y, -1.0, 1.0)) * 0.31830989);
-    return textureLod(u_env_map, uv, rs_env_lod(m)).rgb * u_env_scale;
+    return textureLod(u_env_map, uv, lod).rgb * u_env_scale;
 }
 
 // Directional albedo of a Kelemen/Szirmay-Kalos lobe with rho_s 1 and Fresnel F0, for N.V and m.
@@ -66,8 +65,10 @@ float rs_env_lobe_albedo(float ndotv, float m, float f0)
 // axis: variance spacing^2, plus the taps' own), each tap reweighted by the real lobe over that Gaussian,
 // so the taps below the horizon drop out (the horizon fade of Russell 2015, applied across the lobe) and
 // the rest carry the mean. With 3 x 3 taps a compact lamp fell between them (office, studio: +-25 %).
-vec3 rs_env_specular(vec3 N, vec3 V, float m, float f0)
+vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
 {
+    // All in the environment's frame (a rotation of view space: the lobe's dot products are kept).
+    vec3 N = u_env_from_view * N_view, V = u_env_from_view * V_view;
     float ndotv = max(dot(N, V), 1e-4);
     vec3 R = reflect(-V, N);
     // t1: in the plane of incidence, from R towards N; t2 across it.
@@ -82,19 +83,22 @@ vec3 rs_env_specular(vec3 N, vec3 V, float m, float f0)
     float d1 = min(sigma * sqrt(1.0 - s * s), 0.6);
     float d2 = min(sigma * sqrt(max(across * across - s * s, 0.0)), 0.6);
     float g1 = d1 * d1 / (2.0 * sigma * sigma), g2 = d2 * d2 / (2.0 * sigma * sigma * max(across * across, 1e-4));
-    float mt = s * m;
+    float lod = rs_env_lod(s * m);
+    vec2 o1 = vec2(tan(d1), tan(2.0 * d1)), o2 = vec2(tan(d2), tan(2.0 * d2));
     float fc = max(rs_ksk_lobe(N, R, V, m, f0), 1e-20);
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
     for (int i = -2; i <= 2; i++) {
+        float a = i == 0 ? 0.0 : sign(float(i)) * o1[abs(i) - 1];
         for (int j = -2; j <= 2; j++) {
-            vec3 l = normalize(R + t1 * tan(float(i) * d1) + t2 * tan(float(j) * d2));
+            float b = j == 0 ? 0.0 : sign(float(j)) * o2[abs(j) - 1];
+            vec3 l = normalize(R + t1 * a + t2 * b);
             float f = rs_ksk_lobe(N, l, V, m, f0);
             if (f <= 0.0) continue;
             // Binomial weights times the real lobe over the Gaussian the grid stands for.
             float bi = i == 0 ? 6.0 : abs(i) == 1 ? 4.0 : 1.0, bj = j == 0 ? 6.0 : abs(j) == 1 ? 4.0 : 1.0;
             float w = bi * bj * (f / fc) * exp(float(i * i) * g1 + float(j * j) * g2);
-            sum += rs_env_radiance(l, mt) * w;
+            sum += rs_env_radiance(l, lod) * w;
             wsum += w;
         }
     }
