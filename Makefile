@@ -236,6 +236,15 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a $
 	$(CC) $(CFLAGS) $< $(TEST_SUPPORT_OBJ) $(if $(filter $(PACK_TESTS),$*),$(BUILD)/libpack.a $(PACK_LIBS)) \
 	    $(if $(filter test_env_tool,$*),$(ENV_BAKE_OBJ)) $(TEST_LIBS) $(LDFLAGS) -o $@
 
+# test_env_specular integrates over the source captures (OpenEXR, read as rouge-env reads them): it links
+# rouge-env's reader and bake with the C++ compiler.
+ENV_READ_OBJ := $(ENV_BAKE_OBJ) $(BUILD)/obj/tools/env/env_read.o $(BUILD)/obj/tools/env/exr_read.o
+$(BUILD)/tests/test_env_specular: $(BUILD)/obj/tests/test_env_specular.o $(TEST_SUPPORT_OBJ) $(BUILD)/libapp.a \
+                                  $(BUILD)/librouge.a $(ENV_READ_OBJ)
+	@mkdir -p $(dir $@)
+	$(CXX) $(OPT) -g $(EXTRA_CFLAGS) $< $(TEST_SUPPORT_OBJ) $(ENV_READ_OBJ) $(TEST_LIBS) \
+	    $(shell pkg-config --libs OpenEXR) $(LDFLAGS) -o $@
+
 # Regenerates the committed import fixtures that need JPEG encoding (tests/fixtures/import/head/, *.jpg)
 # from ../shared/data (tools/make_import_fixtures.c; the rest come from tests/fixtures/import/make_fixtures.py).
 $(BUILD)/make-import-fixtures: tools/make_import_fixtures.c $(BUILD)/libpack.a $(BUILD)/librouge.a

@@ -6,6 +6,8 @@
 uniform float u_env_on;             // 0: no environment (key/fill/ambient only)
 uniform mat3 u_env_from_view;
 uniform vec3 u_env_sh[9];           // irradiance / pi, times the environment's exposure normalisation
+uniform vec3 u_env_lamp_dir[3];     // the other compact lamps (render_env.c find_lamps): taken out of the
+uniform vec3 u_env_lamp_color[3];   // SH, lit exactly (unshadowed, diffuse only); colour 0 when unused
 uniform highp sampler2D u_env_map;  // RGB9E5 equirect, level k prefiltered with roughness u_env_m[k]
 uniform float u_env_m[8];
 uniform int u_env_levels;
@@ -21,6 +23,7 @@ vec3 rs_env_irradiance(vec3 n_view)
            + u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
            + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
            + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y));
+    for (int i = 0; i < 3; i++) e += u_env_lamp_color[i] * max(dot(n, u_env_lamp_dir[i]), 0.0);
     return max(e, vec3(0.0));
 }
 
@@ -35,13 +38,12 @@ float rs_env_lod(float m)
     return float(u_env_levels - 1);
 }
 
-// Radiance around view-space direction r, prefiltered for roughness m.
-vec3 rs_env_radiance(vec3 r_view, float m)
+// Radiance around the environment-frame unit direction d, from the map's (fractional) level lod.
+vec3 rs_env_radiance(vec3 d, float lod)
 {
-    vec3 d = normalize(u_env_from_view * r_view);
     // docs/env.md: phi = atan(x, z) from forward towards the subject's left, theta from up.
     vec2 uv = vec2(atan(d.x, d.z) * 0.15915494 + 0.5, acos(clamp(d.y, -1.0, 1.0)) * 0.31830989);
-    return textureLod(u_env_map, uv, rs_env_lod(m)).rgb * u_env_scale;
+    return textureLod(u_env_map, uv, lod).rgb * u_env_scale;
 }
 
 // Directional albedo of a Kelemen/Szirmay-Kalos lobe with rho_s 1 and Fresnel F0, for N.V and m.
@@ -51,11 +53,55 @@ float rs_env_lobe_albedo(float ndotv, float m, float f0)
     return f0 * ab.x + ab.y;
 }
 
-// Environment light reflected by the lobe (N, m, F0) towards V: prefiltered radiance around the mirror
-// direction times the lobe's albedo.
-vec3 rs_env_specular(vec3 N, vec3 V, float m, float f0)
+// Environment light reflected by the lobe (N, m, F0) towards V (split sum): the lobe's albedo (from the
+// table, which integrates the lobe over the upper hemisphere only) times the mean radiance the lobe sees.
+// The prefiltered map averages an isotropic lobe around R (as if N = V = R: a Gaussian of about sqrt(2) m
+// per axis). Seen obliquely the real lobe is narrower across the plane of incidence (a half vector tilted
+// by d across turns l by 2 (V.h) d, not 2 d), skewed by Fresnel and cut by the surface's horizon; the
+// isotropic lookup caught lamps beside and below the reflection (the studio's side lamps: issue 22, up to
+// +400 % at grazing on a sphere). So the mean is taken over a grid of narrower prefiltered lobes (filtered
+// importance sampling, Colbert & Krivanek, GPU Gems 3 ch. 20), spaced for a Gaussian of sqrt(2) m along
+// the plane of incidence and sqrt(2) m (N.V) across (5 x 5 taps, binomial weights [1 4 6 4 1] / 16 per
+// axis: variance spacing^2, plus the taps' own), each tap reweighted by the real lobe over that Gaussian,
+// so the taps below the horizon drop out (the horizon fade of Russell 2015, applied across the lobe) and
+// the rest carry the mean. With 3 x 3 taps a compact lamp fell between them (office, studio: +-25 %).
+vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
 {
+    // All in the environment's frame (a rotation of view space: the lobe's dot products are kept).
+    vec3 N = u_env_from_view * N_view, V = u_env_from_view * V_view;
     float ndotv = max(dot(N, V), 1e-4);
     vec3 R = reflect(-V, N);
-    return rs_env_radiance(R, m) * rs_env_lobe_albedo(ndotv, m, f0);
+    // t1: in the plane of incidence, from R towards N; t2 across it.
+    vec3 t1 = N - R * dot(N, R);
+    float l1 = dot(t1, t1);
+    t1 = l1 > 1e-8 ? t1 * inversesqrt(l1) : (abs(R.y) < 0.9 ? normalize(cross(R, vec3(0.0, 1.0, 0.0)))
+                                                            : normalize(cross(R, vec3(1.0, 0.0, 0.0))));
+    vec3 t2 = cross(R, t1);
+    float sigma = 1.4142 * max(m, 0.02);      // the lobe's spread along the plane, radians
+    float across = clamp(ndotv, 0.0, 1.0);    // across it, relative
+    float s = max(0.6 * across, 0.2);         // the taps' own spread, relative
+    float d1 = min(sigma * sqrt(1.0 - s * s), 0.6);
+    float d2 = min(sigma * sqrt(max(across * across - s * s, 0.0)), 0.6);
+    float g1 = d1 * d1 / (2.0 * sigma * sigma), g2 = d2 * d2 / (2.0 * sigma * sigma * max(across * across, 1e-4));
+    float lod = rs_env_lod(s * m);
+    vec2 o1 = vec2(tan(d1), tan(2.0 * d1)), o2 = vec2(tan(d2), tan(2.0 * d2));
+    float fc = max(rs_ksk_lobe(N, R, V, m, f0), 1e-20);
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
+    for (int i = -2; i <= 2; i++) {
+        float a = i == 0 ? 0.0 : sign(float(i)) * o1[abs(i) - 1];
+        for (int j = -2; j <= 2; j++) {
+            float b = j == 0 ? 0.0 : sign(float(j)) * o2[abs(j) - 1];
+            vec3 l = normalize(R + t1 * a + t2 * b);
+            float f = rs_ksk_lobe(N, l, V, m, f0);
+            if (f <= 0.0) continue;
+            // Binomial weights times the real lobe over the Gaussian the grid stands for.
+            float bi = i == 0 ? 6.0 : abs(i) == 1 ? 4.0 : 1.0, bj = j == 0 ? 6.0 : abs(j) == 1 ? 4.0 : 1.0;
+            float w = bi * bj * (f / fc) * exp(float(i * i) * g1 + float(j * j) * g2);
+            sum += rs_env_radiance(l, lod) * w;
+            wsum += w;
+        }
+    }
+    vec3 L = wsum > 0.0 ? sum / wsum : vec3(0.0);
+    return L * rs_env_lobe_albedo(ndotv, m, f0);
 }

@@ -9,6 +9,7 @@ precision highp float;
 precision highp int;
 #include "splat_decode.glsl"
 #include "shadow_lookup.glsl"
+#include "skin_brdf.glsl"  // env_light.glsl weighs its taps with the lobe
 #include "env_light.glsl"
 
 layout(location = 0) in uvec4 a_splat;

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define PI 3.14159265358979323846
 #define LUT_SIZE 32
 #define LUT_SAMPLES 512
 // Linear RGB -> luminance (Rec. 709).
@@ -76,6 +77,96 @@ static rs_result make_lut(rs_renderer *r, rs_error *err)
     return rs_gl_check("render: specular table", err);
 }
 
+static int cmp_float(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+// The environment's other compact lamps. SH9 cannot hold a small bright source's irradiance (a clamped
+// cosine): with the key light alone taken out, `studio`'s two side lamps left the SH up to 36 % off on
+// normals facing away from the key (12 % of the front's mean irradiance; test_env_specular). So up to
+// RS_ENV_LAMPS more are found in the level-0 map (the remainder, prefiltered with m 0.06: ~5 deg):
+// the brightest texel not yet taken; its region: the texels within 20 deg brighter than
+// sqrt(peak x median); its surround: the mean of the ring 20-25 deg out; the lamp: the region's excess
+// over the surround, (1/pi) sum excess dw at the excess-weighted mean direction. A lamp that carries less
+// than 5 % of the map's mean irradiance is not worth it and ends the search. Each one's SH projection
+// (a directional light of colour c: sh_k = pi a_l c Y_k(d), a_l = 1, 2/3, 1/4) leaves the SH, and the
+// shader adds it exactly (env_light.glsl). The map itself keeps them: the specular reflects them.
+static void find_lamps(const rs_env *env, rs_render_env *e)
+{
+    const rs_env_level *lv = &env->levels[0];
+    int w = lv->width, h = lv->height;
+    size_t n = (size_t)w * h;
+    float *rgb = malloc(sizeof(float) * 3 * n), *lum = malloc(sizeof(float) * n), *dir = malloc(sizeof(float) * 3 * n);
+    float *sorted = malloc(sizeof(float) * n);
+    double *sr = malloc(sizeof(double) * (size_t)h);
+    if (!rgb || !lum || !dir || !sorted || !sr) goto done;
+    for (int j = 0; j < h; j++) {
+        double t0 = PI * j / h, t1 = PI * (j + 1) / h, th = PI * (j + 0.5) / h;
+        sr[j] = 2.0 * PI / w * (cos(t0) - cos(t1));
+        for (int i = 0; i < w; i++) {
+            size_t t = (size_t)j * w + i;
+            double ph = 2.0 * PI * ((i + 0.5) / w - 0.5);
+            dir[3 * t] = (float)(sin(th) * sin(ph)), dir[3 * t + 1] = (float)cos(th), dir[3 * t + 2] = (float)(sin(th) * cos(ph));
+            rs_rgb9e5_unpack(lv->rgb9e5[t], rgb + 3 * t);
+            lum[t] = sorted[t] = LUM(rgb + 3 * t);
+        }
+    }
+    qsort(sorted, n, sizeof *sorted, cmp_float);
+    float median = sorted[n / 2];
+    double mean = 0;  // the map's mean irradiance / pi: its mean radiance
+    for (size_t t = 0; t < n; t++) mean += lum[t] * sr[t / (size_t)w];
+    mean /= 4.0 * PI;
+    const float cos_region = cosf(20.0f * (float)PI / 180), cos_ring = cosf(25.0f * (float)PI / 180);
+    for (int k = 0; k < RS_ENV_LAMPS; k++) {
+        size_t peak = 0;
+        for (size_t t = 1; t < n; t++)
+            if (lum[t] > lum[peak]) peak = t;
+        const float *pd = dir + 3 * peak;
+        float thr = sqrtf(lum[peak] * RS_MAX(median, 1e-12f));
+        double ring[3] = {0, 0, 0}, ring_sr = 0;
+        for (size_t t = 0; t < n; t++) {
+            float c = pd[0] * dir[3 * t] + pd[1] * dir[3 * t + 1] + pd[2] * dir[3 * t + 2];
+            if (c < cos_region && c >= cos_ring) {
+                for (int q = 0; q < 3; q++) ring[q] += rgb[3 * t + q] * sr[t / (size_t)w];
+                ring_sr += sr[t / (size_t)w];
+            }
+        }
+        for (int q = 0; q < 3; q++) ring[q] /= RS_MAX(ring_sr, 1e-12);
+        double col[3] = {0, 0, 0}, d[3] = {0, 0, 0};
+        for (size_t t = 0; t < n; t++) {
+            float c = pd[0] * dir[3 * t] + pd[1] * dir[3 * t + 1] + pd[2] * dir[3 * t + 2];
+            if (c < cos_region || lum[t] <= thr) continue;
+            double dw = sr[t / (size_t)w], ex[3];
+            for (int q = 0; q < 3; q++) {
+                ex[q] = RS_MAX(rgb[3 * t + q] - ring[q], 0.0);
+                col[q] += ex[q] * dw;
+                rgb[3 * t + q] = (float)RS_MIN((double)rgb[3 * t + q], ring[q]);
+            }
+            lum[t] = LUM(rgb + 3 * t);
+            double le = LUM(ex) * dw;
+            for (int q = 0; q < 3; q++) d[q] += le * dir[3 * t + q];
+        }
+        lum[peak] = 0;  // taken, whatever its region held
+        double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int q = 0; q < 3; q++) col[q] /= PI;
+        if (dl <= 0 || LUM(col) < 0.05 * mean) break;
+        float ld[3] = {(float)(d[0] / dl), (float)(d[1] / dl), (float)(d[2] / dl)}, y[9];
+        rs_env_sh_basis(ld, y);
+        static const float band[9] = {1.0f, 2.0f / 3, 2.0f / 3, 2.0f / 3, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
+        for (int b = 0; b < 9; b++)
+            for (int q = 0; q < 3; q++) e->sh[b][q] -= (float)(PI * band[b] * col[q] * y[b]);
+        for (int q = 0; q < 3; q++) e->lamp_dir[k][q] = ld[q], e->lamp_color[k][q] = (float)col[q];
+    }
+done:
+    free(rgb);
+    free(lum);
+    free(dir);
+    free(sorted);
+    free(sr);
+}
+
 // Mean luminance of the irradiance (SH + the dominant light) over normals of the front half-space, by a
 // fixed spiral of directions: what the face mostly shows.
 static float front_irradiance(const rs_env *env)
@@ -132,8 +223,12 @@ rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
     e->on = true;
     float front = front_irradiance(env);
     e->scale = front > 1e-6f ? ENV_TARGET_FRONT / front : 1.0f;
+    memcpy(e->sh, env->sh, sizeof e->sh);
+    find_lamps(env, e);
     for (int k = 0; k < 9; k++)
-        for (int c = 0; c < 3; c++) e->sh[k][c] = env->sh[k][c] * e->scale;
+        for (int c = 0; c < 3; c++) e->sh[k][c] *= e->scale;
+    for (int k = 0; k < RS_ENV_LAMPS; k++)
+        for (int c = 0; c < 3; c++) e->lamp_color[k][c] *= e->scale;
     for (int c = 0; c < 3; c++) {
         e->light_dir[c] = env->light_dir[c];
         e->light_color[c] = env->light_color[c] * e->scale;
@@ -160,6 +255,11 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
         for (int c = 0; c < 3; c++) sh[k][c] = r->env.sh[k][c] * e;
     glUniformMatrix3fv(rs_uloc(prog, "u_env_from_view"), 1, GL_FALSE, (const float *)f->env_from_view);
     glUniform3fv(rs_uloc(prog, "u_env_sh"), 9, &sh[0][0]);
+    float lamp[RS_ENV_LAMPS][3];
+    for (int k = 0; k < RS_ENV_LAMPS; k++)
+        for (int c = 0; c < 3; c++) lamp[k][c] = r->env.lamp_color[k][c] * e;
+    glUniform3fv(rs_uloc(prog, "u_env_lamp_dir"), RS_ENV_LAMPS, &r->env.lamp_dir[0][0]);
+    glUniform3fv(rs_uloc(prog, "u_env_lamp_color"), RS_ENV_LAMPS, &lamp[0][0]);
     glUniform1fv(rs_uloc(prog, "u_env_m"), RS_ENV_MAX_LEVELS, r->env.level_m);
     glUniform1i(rs_uloc(prog, "u_env_levels"), r->env.levels);
     glUniform1f(rs_uloc(prog, "u_env_scale"), r->env.scale * e);

@@ -64,6 +64,8 @@ typedef struct rs_render_fine {
     uint32_t last_product_count;
 } rs_render_fine;
 
+#define RS_ENV_LAMPS 3  // env_light.glsl's u_env_lamp_* arrays
+
 // The environment as uploaded (render_env.c): radiance and SH scaled by the exposure normalisation.
 typedef struct rs_render_env {
     bool on;
@@ -72,6 +74,10 @@ typedef struct rs_render_env {
     float light_dir[3];          // environment frame, towards the light
     float light_color[3];
     float light_angle;           // radians
+    // The environment's other compact lamps (render_env.c find_lamps): unshadowed, diffuse only, taken out
+    // of sh; colour 0 where unused.
+    float lamp_dir[RS_ENV_LAMPS][3];
+    float lamp_color[RS_ENV_LAMPS][3];
     int levels;
     float level_m[RS_ENV_MAX_LEVELS];
 } rs_render_env;
