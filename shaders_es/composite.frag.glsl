@@ -69,20 +69,65 @@ vec4 flake_hash(ivec3 c)
     return vec4(v, w * 747796405u) / 4294967295.0;
 }
 
-// The flakes of a shimmer finish: tiny mirrors in cells of u_flake_size on the surface, each tilted at
-// random by up to ~25 degrees from the surface normal; about a third of the cells hold one. A flake
-// lights up when its own mirror direction meets a bright part of the light: sparkle that moves with the
-// light and the face.
-vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao)
+// The flakes of a shimmer finish: pearl pigment, tiny mirrors (u_flake_size) lying in the film, tilted at
+// random about the surface normal (Beckmann spread FLAKE_TILT, each with its own lobe of FLAKE_M), over
+// FLAKE_FILL of the surface at full shimmer. They are smaller than a pixel, so a pixel shows their sum over
+// its footprint on the surface (a filtered glint, not a pixel-sized mirror): the mean, a broad sheen lobe
+// of roughness sqrt(tilt^2 + m^2) that catches the light, times the count of flakes that happen to mirror
+// the key light over the count expected. That count is Poisson(lambda), lambda = the flakes in the
+// footprint x the share of their orientations that see the key, drawn from a hash of the footprint's cell
+// on the surface and of the half vector: fixed on the face, other flakes as the light or the face turns
+// (sparkle). One flake adds mean / lambda: a fine glint where the flakes are many, nothing in a full-face
+// view but the sheen.
+#define FLAKE_TILT 0.3
+#define FLAKE_M 0.08
+#define FLAKE_FILL 0.35
+#define FLAKE_REFLECTANCE 0.35  // a pearl (mica / TiO2) flake's reflectance at its colour
+vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, float amount)
 {
-    vec3 pm = (u_inv_view * vec4(p, 1.0)).xyz;
-    vec4 h = flake_hash(ivec3(floor(pm / u_flake_size)));
-    if (h.w > 0.35) return vec3(0.0);
-    vec3 Nf = normalize(N + (h.xyz * 2.0 - 1.0) * 0.45);
-    const float mf = 0.08;
-    vec3 s = u_key_color * (rs_ksk_lobe(Nf, u_key_dir, V, sqrt(mf * mf + u_key_widen * u_key_widen), 0.5) * shadow);
-    if (u_env_on > 0.5) s += rs_env_specular(Nf, V, mf, 0.5) * ao;
-    return s * tint;
+    float cover = FLAKE_FILL * amount;
+    if (cover <= 0.0) return vec3(0.0);
+    float me = sqrt(FLAKE_TILT * FLAKE_TILT + FLAKE_M * FLAKE_M);
+    float w2 = u_key_widen * u_key_widen;
+    // The key light over all flake orientations (unit reflectance, per unit of cover).
+    float key = rs_ksk_lobe(N, u_key_dir, V, sqrt(me * me + w2), 1.0) * shadow;
+    float g = 1.0;
+    if (key > 0.0) {
+        // The share of flakes that mirror the key: the orientation density at the half vector over one
+        // aligned flake's peak (Beckmann peak 1 / m^2).
+        vec3 H = normalize(u_key_dir + V);
+        float share = min(rs_beckmann(max(dot(N, H), 1e-3), sqrt(me * me + w2)) * (FLAKE_M * FLAKE_M + w2), 1.0);
+        // The pixel's footprint on the surface (view units = model units) and the flakes in it.
+        float s = 2.0 * length(p) / (u_proj[1][1] * u_viewport.y);
+        float area = s * s / max(dot(N, V), 0.2);
+        float lambda = cover * area / (0.785398 * u_flake_size * u_flake_size) * share;
+        // Cells of the footprint's size on the surface (a power of two of the flake size: stable while the
+        // view moves by less than a zoom step) hold one draw each.
+        float level = floor(log2(max(s / u_flake_size, 1.0)));
+        vec3 pm = (u_inv_view * vec4(p, 1.0)).xyz;
+        // Which flakes mirror the key depends on where the half vector points: one draw per bin of it (on
+        // the face, a flake lobe wide), so when the light or the face turns other flakes glint.
+        ivec3 hb = ivec3(floor(mat3(u_inv_view) * H / (FLAKE_M + u_key_widen)));
+        vec4 h = flake_hash(ivec3(floor(pm / (u_flake_size * exp2(level)))) + ivec3(int(level) * 7919) + hb * 104729);
+        float n;
+        if (lambda < 24.0) {
+            // Poisson by its inverse CDF.
+            float pk = exp(-lambda), cdf = pk;
+            n = 0.0;
+            for (int k = 1; k < 64 && h.w > cdf; k++) {
+                pk *= lambda / float(k);
+                cdf += pk;
+                n += 1.0;
+            }
+        } else {
+            // Many flakes: the normal approximation (Box-Muller).
+            n = lambda + sqrt(lambda) * sqrt(-2.0 * log(max(h.x, 1e-7))) * cos(6.2831853 * h.y);
+        }
+        g = lambda > 1e-6 ? max(n, 0.0) / lambda : 0.0;
+    }
+    vec3 s3 = u_key_color * (key * g);
+    if (u_env_on > 0.5) s3 += rs_env_specular(N, V, me, 1.0) * ao;
+    return s3 * (tint * (FLAKE_REFLECTANCE * cover));
 }
 
 vec3 linear_to_srgb(vec3 c)
@@ -245,7 +290,7 @@ void main()
         }
         C *= coat;
         // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).
-        if (shimmer > 0.0) C += flakes(p, N, V, A / max(max(A.r, max(A.g, A.b)), 0.05), shadow, ao) * shimmer;
+        if (shimmer > 0.0) C += flakes(p, N, V, A / max(max(A.r, max(A.g, A.b)), 0.05), shadow, ao, shimmer);
         // The Gaussians too narrow to draw take the pixel's own irradiance. At an occluding contour or a
         // crease (nostril rim, lid fold) that pixel sees a sliver of surface edge-on, whose interpolated
         // normal can turn fully away from (or into) the light: one pixel's E drops to 0 while every drawn

@@ -30,8 +30,9 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     bool filmic = v->tonemap == RS_TONEMAP_FILMIC || (v->tonemap == RS_TONEMAP_DEFAULT && f->env_on);
     glUniform1i(rs_uloc(prog, "u_tonemap"), filmic ? 0 : 1);
     glUniformMatrix4fv(rs_uloc(prog, "u_inv_view"), 1, GL_FALSE, (const float *)cam->inv_view);
-    // Flakes of ~0.3 mm: a few pixels each in a close-up, about one per pixel in a full-face view.
-    glUniform1f(rs_uloc(prog, "u_flake_size"), 0.3f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
+    // Shimmer flakes of 60 um: pearl pigments are 10-60 um, the sparkling grades at the top of that range.
+    // Below a pixel even in a 3x close-up (~0.2 mm): a pixel sums a few to hundreds of them.
+    glUniform1f(rs_uloc(prog, "u_flake_size"), 0.060f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
     glUniform1f(rs_uloc(prog, "u_contour_reach"), 20.0f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
     rs_render_env_uniforms(r, f, prog);
     // Under an environment the highlight is what skin's surface reflects, white (a dielectric); the
