@@ -80,14 +80,21 @@ static bool upload_dirty(rs_makeup *mk)
             !RS_CHECK(rs_render_update_makeup(ren, rg[i].lo, rg[i].hi - rg[i].lo, rec + rg[i].lo, &err) == RS_OK,
                       "upload: %s", err.msg))
             return false;
-    return true;
+    // The fine layer (narrow brushes, brushes kept to the lips or eyes: drawn per pixel) as a whole.
+    rs_makeup_fine_stamp *fs = NULL;
+    uint32_t nf = 0;
+    bool ok = RS_CHECK(rs_makeup_fine_stamps(mk, &fs, &nf, &err) == RS_OK &&
+                           rs_render_update_fine(ren, fs, nf, mk, &err) == RS_OK, "fine layer: %s", err.msg);
+    free(fs);
+    return ok;
 }
 
-// Clears the renderer's makeup records (what earlier tests left there).
+// Clears the renderer's makeup records and fine layer (what earlier tests left there).
 static bool clear_renderer_layer(void)
 {
     rs_error err = {0};
-    return RS_CHECK(rs_render_update_makeup(ren, 0, face->hdr.count, zeros, &err) == RS_OK, "%s", err.msg);
+    return RS_CHECK(rs_render_update_makeup(ren, 0, face->hdr.count, zeros, &err) == RS_OK &&
+                        rs_render_update_fine(ren, NULL, 0, NULL, &err) == RS_OK, "%s", err.msg);
 }
 
 // The bare face in this mode.
