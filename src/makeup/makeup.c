@@ -1135,6 +1135,18 @@ rs_result rs_makeup_fine_stamps(const rs_makeup *mk, rs_makeup_fine_stamp **out,
     return RS_OK;
 }
 
+// Whether the applied log (rs_makeup_log_stamps) holds a fine stamp.
+static bool log_has_fine(const rs_makeup *mk)
+{
+    const rs_makeup_applied *log = rs_makeup_log_stamps(mk);
+    for (uint32_t k = 0, n = rs_makeup_log_count(mk); k < n; k++) {
+        const rs_makeup_applied *s = &log[k];
+        if (!s->eraser && stamp_is_fine(mk, &mk->cosmetics[s->cosmetic], false, s->region_mask, s->radius))
+            return true;
+    }
+    return false;
+}
+
 // --- stamping --------------------------------------------------------------------------------------
 
 typedef struct stamp_ctx {
@@ -1321,7 +1333,9 @@ rs_result rs_makeup_stamp(rs_makeup *mk, const rs_makeup_stamp_desc *d, rs_makeu
                            mk->stamp_count == mk->stroke_first_stamp,
                            masked};
     mk->fine_version++;
-    mk->stroke_fine |= fine;
+    // An eraser over fine stamps changes the picture even where it changes no record (a lipstick drawn per
+    // pixel over bare skin): the stroke must stay in the log, which is where the renderer reads it.
+    mk->stroke_fine |= fine || (d->eraser && !mk->stroke_fine && log_has_fine(mk));
     if (fine) mk->stamps[mk->stamp_count++] = s;
     else apply_stamp(mk, &s, cos, mask, info);
     if (mirror_idx != UINT32_MAX) {

@@ -1,8 +1,8 @@
 // render_fine.c — the makeup's fine layer (makeup.c, "Two resolutions"): narrow-brush stamps evaluated per
 // pixel in stage 5 at the surface point each pixel sees, so a liner's edge is as sharp as the picture, not
 // as soft as the splats. Uploads the stamps and their products into an RGBA32F texture and a uniform
-// model-space grid over them (cell >= the widest stamp's diameter, so a stamp is listed in at most 8 cells)
-// into an R32UI texture: per cell (start, count), then the stamp lists in log order. Both are read with
+// model-space grid over them (cell >= the typical stamp's diameter; a wider one is listed in every cell it
+// reaches) into an R32UI texture: per cell (start, count), then the stamp lists in log order. Both are read with
 // texelFetch only and never attached to a framebuffer (WebGL 2 rejects feedback loops).
 #include "render/render_internal.h"
 
@@ -70,8 +70,24 @@ static uint32_t *build_index(rs_render_fine *g, const rs_makeup_fine_stamp *s, u
         for (int a = 0; a < 3; a++)
             lo[a] = fminf(lo[a], s[k].pos[a] - s[k].radius), hi[a] = fmaxf(hi[a], s[k].pos[a] + s[k].radius);
     }
+    // Cells fit the typical stamp (the median radius, from a histogram in quarter octaves below the
+    // widest): a pixel looks at the stamps near it, not at every stamp within the widest one's reach (a
+    // wide eraser or lipstick among liner stamps); a wider stamp is listed in every cell it reaches.
+    enum { BINS = 64 };
+    uint32_t bins[BINS] = {0};
+    for (uint32_t k = 0; k < n; k++) {
+        int b = s[k].radius > 0.0f ? (int)(-4.0f * log2f(s[k].radius / rmax)) : BINS - 1;
+        bins[RS_CLAMP(b, 0, BINS - 1)]++;
+    }
+    int med = BINS - 1;
+    for (uint32_t b = BINS, seen = 0; b-- > 0;)
+        if ((seen += bins[b]) * 2 >= n) {
+            med = (int)b;
+            break;
+        }
+    float rtyp = rmax * exp2f(-0.25f * (float)med);
     float ext = fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-    float cell = fmaxf(2.0f * rmax, ext / (float)FINE_DIM_MAX) * 1.001f;
+    float cell = fmaxf(2.0f * rtyp, ext / (float)FINE_DIM_MAX) * 1.001f;
     g->inv_cell = 1.0f / cell;
     uint32_t cells = 1;
     for (int a = 0; a < 3; a++) {
