@@ -441,7 +441,9 @@ typedef struct rouge_brush {
     // Region-aware by default: lipstick and gloss stay on the lips, shadow on the eye area, base,
     // powder, blush, bronzer and highlighter off the lips, eyes and brows, with a soft edge (~1.5 mm) at
     // the region's border. true paints anywhere. Faces converted without eyelid/brow regions keep eye
-    // products unmasked. A brush narrower than 4 mm (liner, brow pencil, mascara at their sizes) is
+    // products unmasked. A brush kept to the lips or the eyes is drawn per pixel, masked by a smooth
+    // field of its region (the lips': where the lip colour ends), so its edge is a clean line at the
+    // picture's resolution. A brush narrower than 4 mm (liner, brow pencil, mascara at their sizes) is
     // drawn per pixel exactly where it is painted and is not masked: a pencil is its own mask.
     bool any_region;
     // 0 = paint. With smudge or blend, opacity is the tool's strength (0 = 0.8) and size its size.

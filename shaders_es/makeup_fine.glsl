@@ -8,6 +8,8 @@
 // (product, stroke, eraser, 0); from u_fine_products, per product 3 texels = (linear rgb, colour weight),
 // (m, rho_s, finish weight, I_M), (coat, shimmer, coverage, tip hardness).
 // u_fine_index (R32UI, 1024 wide): per grid cell (start, count), then the cells' stamp lists in log order.
+// u_fine_field (R8 3D, linear): the region masks' fields (makeup.c, "Region masks per pixel") stacked
+// along z; a stamp kept to a region (product texel's w) takes the field's ramp at the point as its mask.
 uniform highp sampler2D u_fine_data;
 uniform highp usampler2D u_fine_index;
 uniform int u_fine_count;        // 0: no fine layer
@@ -19,6 +21,11 @@ uniform vec3 rs_makeup_range_lo; // the face's colour range (makeup.glsl)
 uniform vec3 rs_makeup_range_hi;
 
 #define RS_FINE_LIST_MAX 4096    // stamps looked at per pixel, at most
+#define RS_FINE_REGIONS 5        // RS_COSMETIC_REGION_COUNT (render_fine.c checks)
+
+uniform mediump sampler3D u_fine_field;
+uniform vec4 u_fine_field_box[2 * RS_FINE_REGIONS];  // per region (origin, 1 / voxel), (dims, first slice)
+uniform vec2 u_fine_field_ramp[RS_FINE_REGIONS];     // per region (threshold, band)
 
 vec4 rs_fine_texel(int i) { return texelFetch(u_fine_data, ivec2(i & 1023, i >> 10), 0); }
 uint rs_fine_entry(uint i) { return texelFetch(u_fine_index, ivec2(int(i & 1023u), int(i >> 10u)), 0).r; }
@@ -37,6 +44,19 @@ float rs_fine_falloff(float u, float hard)
     if (hard > 0.0) return smoothstep(0.0, 1.0, (1.0 - u) / (1.0 - hard));
     const float rim = 0.1353352832;  // exp(-2)
     return (exp(-2.0 * u * u) - rim) / (1.0 - rim);
+}
+
+// A region mask's weight at model-space point pm: its field interpolated there (the voxel centres are
+// the texel centres), ramped linearly over the band around the threshold. 1 where the region has no field.
+float rs_fine_region_weight(int region, vec3 pm)
+{
+    vec4 a = u_fine_field_box[2 * region], b = u_fine_field_box[2 * region + 1];
+    if (b.x == 0.0) return 1.0;
+    vec3 t = clamp((pm - a.xyz) * a.w, vec3(0.5), b.xyz - 0.5);  // within the region's own slices
+    t.z += b.w;
+    float f = textureLod(u_fine_field, t / vec3(textureSize(u_fine_field, 0)), 0.0).r;
+    vec2 ramp = u_fine_field_ramp[region];
+    return clamp((f - ramp.x) / ramp.y + 0.5, 0.0, 1.0);
 }
 
 // One stroke's contribution (intensity a of product p, or an eraser) stacked onto the layer (makeup.c
@@ -83,6 +103,8 @@ void rs_fine_apply(vec3 pm, vec3 nm, inout vec3 albedo, inout float m, inout flo
     float touches = 0.0, best = 0.0, stroke = -1.0;
     int product = 0;
     bool eraser = false, reached = false;
+    int region = 0;        // the last region's weight here, kept: a stroke's stamps share their region
+    float region_w = 1.0;
     for (uint k = 0u; k < n; k++) {
         int s = int(rs_fine_entry(start + k));
         vec4 t0 = rs_fine_texel(3 * s), t1 = rs_fine_texel(3 * s + 1), t2 = rs_fine_texel(3 * s + 2);
@@ -95,6 +117,11 @@ void rs_fine_apply(vec3 pm, vec3 nm, inout vec3 albedo, inout float m, inout flo
         product = int(t2.x), eraser = t2.z > 0.5;
         vec4 pr = rs_fine_texel(u_fine_products + 3 * product + 2);
         float ig = rs_fine_falloff(length(pm - t0.xyz) / t0.w, eraser ? 0.0 : pr.w);
+        int reg = int(t2.w);
+        if (reg != 0 && ig > 0.0) {
+            if (reg != region) region = reg, region_w = rs_fine_region_weight(reg, pm);
+            ig *= region_w;
+        }
         if (ig <= 0.0) continue;
         if (!reached && !eraser) touches += 1.0;
         reached = true;

@@ -10,7 +10,7 @@
 #include "env/env_bake.h"
 #include "env/env_read.h"
 #include "formats/env.h"
-#include "render/render_internal.h"  // the renderer's exposure normalisation (r->env.scale)
+#include "render/render_kit.h"  // the renderer's exposure normalisation (r->env.scale)
 
 #include <math.h>
 #include <stdio.h>

@@ -491,13 +491,17 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
            " edges wander %.2f px (top) / %.2f px (bottom) from their smoothed lines\n", 100 * cu, 100 * cl,
            100 * sp, wt, wb);
     // Issue 21's goal (>= 95 % of each lip, <= 0.5 % spill, edges within 1 px of their smoothed lines) is
-    // not met yet: the lips mask is per splat, so its border is not the lip line's shape. Until it is,
-    // today's numbers (91.0 / 95.9 %, spill 6.0 %, wander 2.1 / 3.1 px) are guarded against regressions.
+    // not met yet. The lipstick is drawn per pixel, masked by the lips' field (makeup.c, "Region masks per
+    // pixel"): its edges are the field's smooth level line, no longer the splats' staircase, but that line
+    // is not yet the border this test reads from the picture (the cupid's bow, the lower lip's soft bottom
+    // edge) and the dark mouth line falls below the lip colour's cut. Until it is, today's numbers
+    // (85.4 / 94.9 %, spill 3.1 %, wander 0.81 / 1.66 px; per splat they were 91.0 / 95.9 %, 6.0 %,
+    // 2.1 / 3.1 px) are guarded against regressions.
     bool goal = cu >= 0.95 && cl >= 0.95 && sp <= 0.005 && wt <= 1.0 && wb <= 1.0;
-    bool held = cu >= 0.89 && cl >= 0.94 && sp <= 0.07 && wt <= 2.6 && wb <= 3.6;
+    bool held = cu >= 0.84 && cl >= 0.93 && sp <= 0.037 && wt <= 1.1 && wb <= 2.0;
     RS_CHECK(goal || held,
-             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 91.0 / 95.9), spill %.2f %% (was 6.0), "
-             "edges wander %.2f / %.2f px (were 2.1 / 3.1)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
+             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 85.4 / 94.9), spill %.2f %% (was 3.1), "
+             "edges wander %.2f / %.2f px (were 0.81 / 1.66)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
     free(top), free(bottom), free(d), free(full), free(mid[1]), free(mid[2]), free(lip), free(mouth);
     free(bare), free(paint);
     rouge_face_clear(face, &e);

@@ -928,12 +928,25 @@ static void test_lips_mask_follows_the_lip_colour_not_the_ragged_region(void)
     rs_splat_destroy(c);
 }
 
+// A region field's weight at (x, y, z): the nearest voxel's value through the ramp (makeup_fine.glsl
+// interpolates; away from the border the two agree).
+static float field_weight(const rs_makeup_field *f, float x, float y, float z)
+{
+    float p[3] = {x, y, z};
+    int v[3];
+    for (int a = 0; a < 3; a++) v[a] = RS_CLAMP((int)floorf((p[a] - f->origin[a]) / f->voxel), 0, f->dim[a] - 1);
+    float q = f->value[((size_t)v[2] * f->dim[1] + v[1]) * f->dim[0] + v[0]] / 255.0f;
+    return RS_CLAMP((q - f->threshold) / f->band + 0.5f, 0.0f, 1.0f);
+}
+
 static void test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_masked(void)
 {
     rs_splat_cloud *c = split_plane();
     rs_makeup *mk = layer(c, NULL);
     REQUIRE(mk);
-    // A lipstick dab centred on the border, kept to the lips and not.
+    // A lipstick dab centred on the border, kept to the lips and not. Kept to the lips it is drawn per
+    // pixel (makeup.c, "Region masks per pixel"): no record changes, one fine stamp masked by the lips'
+    // field, which is 1 on the lips and 0 off them.
     for (int masked = 1; masked >= 0; masked--) {
         rs_makeup_stamp_desc d = stamp_at(0.0f, 0.0f, 0.1f, "lipstick_matte");
         d.region_mask = masked;
@@ -942,8 +955,22 @@ static void test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_mas
         for (uint32_t i = 0; i < c->hdr.count; i++)
             if (rs_makeup_records(mk)[i].colour_i || rs_makeup_records(mk)[i].spec_i)
                 *(c->pos[i][0] < 0 ? &left : &right) += 1;
-        if (masked) RS_CHECK(left > 100 && right == 0, "masked: %u painted on the lips, %u off them", left, right);
-        else RS_CHECK(right > 100, "unmasked: only %u painted off the lips", right);
+        rs_makeup_fine_stamp *fs = NULL;
+        uint32_t nf = 0;
+        rs_error err = {0};
+        REQUIRE(rs_makeup_fine_stamps(mk, &fs, &nf, &err) == RS_OK);
+        if (masked) {
+            const rs_makeup_field *f = rs_makeup_region_field(mk, RS_COSMETIC_REGION_LIPS);
+            RS_CHECK(left == 0 && right == 0, "masked: %u / %u records painted (drawn per pixel)", left, right);
+            RS_CHECK(nf == 1 && fs[0].region == RS_COSMETIC_REGION_LIPS, "masked: %u fine stamps, region %u", nf,
+                     nf ? fs[0].region : 0);
+            REQUIRE(f);
+            float in = field_weight(f, -0.05f, 0.0f, 0.0f), out = field_weight(f, 0.05f, 0.0f, 0.0f);
+            RS_CHECK(in == 1.0f && out == 0.0f, "the lips' field: %.2f on the lips, %.2f off them", in, out);
+        } else {
+            RS_CHECK(right > 100 && nf == 0, "unmasked: only %u painted off the lips, %u fine stamps", right, nf);
+        }
+        free(fs);
         RS_CHECK(rs_makeup_log_stamps(mk)[rs_makeup_log_count(mk) - 1].region_mask == masked, "log flag");
         if (masked) REQUIRE(rs_makeup_undo(mk, NULL));
     }

@@ -80,14 +80,21 @@ static bool upload_dirty(rs_makeup *mk)
             !RS_CHECK(rs_render_update_makeup(ren, rg[i].lo, rg[i].hi - rg[i].lo, rec + rg[i].lo, &err) == RS_OK,
                       "upload: %s", err.msg))
             return false;
-    return true;
+    // The fine layer (narrow brushes, brushes kept to the lips or eyes: drawn per pixel) as a whole.
+    rs_makeup_fine_stamp *fs = NULL;
+    uint32_t nf = 0;
+    bool ok = RS_CHECK(rs_makeup_fine_stamps(mk, &fs, &nf, &err) == RS_OK &&
+                           rs_render_update_fine(ren, fs, nf, mk, &err) == RS_OK, "fine layer: %s", err.msg);
+    free(fs);
+    return ok;
 }
 
-// Clears the renderer's makeup records (what earlier tests left there).
+// Clears the renderer's makeup records and fine layer (what earlier tests left there).
 static bool clear_renderer_layer(void)
 {
     rs_error err = {0};
-    return RS_CHECK(rs_render_update_makeup(ren, 0, face->hdr.count, zeros, &err) == RS_OK, "%s", err.msg);
+    return RS_CHECK(rs_render_update_makeup(ren, 0, face->hdr.count, zeros, &err) == RS_OK &&
+                        rs_render_update_fine(ren, NULL, 0, NULL, &err) == RS_OK, "%s", err.msg);
 }
 
 // The bare face in this mode.
@@ -896,8 +903,11 @@ static void check_look_on_lods(bool masked)
         RS_REQUIRE(rs_image_compare(&coarse, &painted, 3, &m, &err) == RS_OK, "%s", err.msg);
         note("look on the %u-splat LOD%s: %.4f%% of pixels > 3 levels, max %d, PSNR %.1f dB", n,
              masked ? " (kept to regions)" : "", 100 * m.frac_over, m.max_abs, m.psnr);
+        // Kept to regions, the lipstick's edge is a crisp line (the lips' field, drawn per pixel) that the
+        // coarser LOD's field places up to a pixel away: those few edge pixels change by the lipstick's
+        // full contrast, so the bound is on how many there are.
         double max_frac = masked ? 0.003 : 0.001;
-        int max_abs = masked ? 16 : 8;
+        int max_abs = masked ? 48 : 8;
         if (!RS_CHECK(m.frac_over <= max_frac && m.max_abs <= max_abs,
                       "look on the %u-splat LOD%s: %.3f%% of pixels differ by > 3 levels (allowed %.1f%%), max %d "
                       "(allowed %d)",

@@ -68,6 +68,10 @@ typedef enum rs_makeup_pressure {
 #define RS_MAKEUP_MASK_EDGE_MM 1.5f // region masks fade in over this distance inside the region's border
 #define RS_MAKEUP_LIP_SMOOTH_MM 3.0f // the lips mask: lip colour averaged over this radius (makeup.c)
 #define RS_MAKEUP_FINE_RADIUS_MM 4.0f // brushes narrower than this are the fine layer: evaluated per pixel
+#define RS_MAKEUP_FIELD_VOXEL_MM 0.4f // region fields (rs_makeup_field): voxel edge, at least
+#define RS_MAKEUP_LIP_A_SPAN 12.0f    // the lips' field: CIELAB a* within this of the lip/skin cut (makeup.c)
+#define RS_MAKEUP_LIP_FIELD_MM 3.0f   // the lips' field: lip colour averaged over this radius (makeup.c)
+#define RS_MAKEUP_LIP_LINE_BAND 0.1f  // the lipstick's edge: the field's rise over it (a* +-1.2 about the cut)
 
 typedef struct rs_makeup_desc {
     uint32_t undo_levels;  // strokes kept for undo/redo; 0 = 64
@@ -107,15 +111,28 @@ typedef struct rs_makeup_applied {
     uint8_t region_mask;    // 1: kept to its cosmetic's region (rs_makeup_stamp_desc.region_mask)
 } rs_makeup_applied;
 
-// One stamp of the fine layer (a brush narrower than RS_MAKEUP_FINE_RADIUS_MM, or an eraser after one): the
-// renderer evaluates these per pixel at the picture's resolution instead of per splat (makeup.c, top).
+// One stamp of the fine layer (a brush narrower than RS_MAKEUP_FINE_RADIUS_MM, a brush kept to a region
+// that has a field, or an eraser after one): the renderer evaluates these per pixel at the picture's
+// resolution instead of per splat (makeup.c, top). New fields go at the end (render_fine.c packs them).
 typedef struct rs_makeup_fine_stamp {
     float pos[3], radius;       // model units
     float view_dir[3], amount;  // as rs_makeup_applied
     uint32_t cosmetic;          // index into rs_makeup_log_cosmetic; unused for the eraser
     uint32_t stroke;            // ordinal of its stroke: a stroke's stamps take the max, strokes stack
     uint32_t eraser;            // 1: lowers the fine layer's intensities
+    uint32_t region;            // rs_cosmetic_region whose field (rs_makeup_region_field) masks it; 0 none
 } rs_makeup_fine_stamp;
+
+// A region mask as a smooth field over model space, for the renderer to evaluate per pixel (makeup.c,
+// "Region masks per pixel"): voxel (i, j, k) holds the mask's smoothed value at origin + (i+.5, j+.5,
+// k+.5) * voxel; the weight at a point is the field interpolated there, ramped linearly from 0 at
+// threshold - band / 2 to 1 at threshold + band / 2.
+typedef struct rs_makeup_field {
+    float origin[3], voxel;  // model units
+    int dim[3];
+    uint8_t *value;          // q/255, x fastest; NULL: no field
+    float threshold, band;
+} rs_makeup_field;
 
 typedef struct rs_makeup rs_makeup;
 
@@ -176,9 +193,13 @@ const rs_cosmetic *rs_makeup_log_cosmetic(const rs_makeup *mk, uint32_t i);
 // then ignored) or for RS_COSMETIC_REGION_ANY. Fails only on out-of-memory.
 rs_result rs_makeup_region_weights(rs_makeup *mk, rs_cosmetic_region region, const uint8_t **out, rs_error *err);
 
-// Whether a stamp of this radius (model units) belongs to the fine layer (erasers never alone: see
-// rs_makeup_fine_stamps).
+// Whether a stamp of this radius (model units) belongs to the fine layer whatever its region (erasers
+// never alone: see rs_makeup_fine_stamps).
 bool rs_makeup_is_fine(const rs_makeup *mk, float radius);
+// The field of a region's mask, built with the mask (rs_makeup_region_weights) for the lips and the eyes;
+// NULL for other regions, before the mask is built, or where the face has no such region. Brushes kept
+// to a region with a field are drawn per pixel, masked by it.
+const rs_makeup_field *rs_makeup_region_field(const rs_makeup *mk, rs_cosmetic_region region);
 // Counts every change of the stamp log (stamp, undo, redo, clear, reset, cancel): the renderer re-reads
 // the fine layer when it moves.
 uint32_t rs_makeup_fine_version(const rs_makeup *mk);

@@ -68,5 +68,6 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glDrawArrays(GL_TRIANGLES, 0, 3);
     // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
     for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_FINE_INDEX; i++) rs_render_bind_texture(i, 0);
+    rs_render_fine_unbind();
     return RS_OK;
 }

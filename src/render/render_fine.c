@@ -1,8 +1,8 @@
 // render_fine.c — the makeup's fine layer (makeup.c, "Two resolutions"): narrow-brush stamps evaluated per
 // pixel in stage 5 at the surface point each pixel sees, so a liner's edge is as sharp as the picture, not
 // as soft as the splats. Uploads the stamps and their products into an RGBA32F texture and a uniform
-// model-space grid over them (cell >= the widest stamp's diameter, so a stamp is listed in at most 8 cells)
-// into an R32UI texture: per cell (start, count), then the stamp lists in log order. Both are read with
+// model-space grid over them (cell >= the typical stamp's diameter; a wider one is listed in every cell it
+// reaches) into an R32UI texture: per cell (start, count), then the stamp lists in log order. Both are read with
 // texelFetch only and never attached to a framebuffer (WebGL 2 rejects feedback loops).
 #include "render/render_stages.h"
 
@@ -14,6 +14,7 @@
 #define FINE_DIM_MAX 32            // grid cells per axis
 #define FINE_STAMPS_MAX 200000u    // ~600k texels; a session's fine strokes stay far below
 #define PRODUCT_FLOATS 12
+_Static_assert(RS_COSMETIC_REGION_COUNT == 5, "shaders_es/makeup_fine.glsl: RS_FINE_REGIONS");
 
 // The product as the shader composes it: linear colour, weights, finish, layers, tip hardness.
 static void product_floats(const rs_cosmetic *c, float out[PRODUCT_FLOATS])
@@ -69,8 +70,24 @@ static uint32_t *build_index(rs_render_fine *g, const rs_makeup_fine_stamp *s, u
         for (int a = 0; a < 3; a++)
             lo[a] = fminf(lo[a], s[k].pos[a] - s[k].radius), hi[a] = fmaxf(hi[a], s[k].pos[a] + s[k].radius);
     }
+    // Cells fit the typical stamp (the median radius, from a histogram in quarter octaves below the
+    // widest): a pixel looks at the stamps near it, not at every stamp within the widest one's reach (a
+    // wide eraser or lipstick among liner stamps); a wider stamp is listed in every cell it reaches.
+    enum { BINS = 64 };
+    uint32_t bins[BINS] = {0};
+    for (uint32_t k = 0; k < n; k++) {
+        int b = s[k].radius > 0.0f ? (int)(-4.0f * log2f(s[k].radius / rmax)) : BINS - 1;
+        bins[RS_CLAMP(b, 0, BINS - 1)]++;
+    }
+    int med = BINS - 1;
+    for (uint32_t b = BINS, seen = 0; b-- > 0;)
+        if ((seen += bins[b]) * 2 >= n) {
+            med = (int)b;
+            break;
+        }
+    float rtyp = rmax * exp2f(-0.25f * (float)med);
     float ext = fmaxf(fmaxf(hi[0] - lo[0], hi[1] - lo[1]), hi[2] - lo[2]);
-    float cell = fmaxf(2.0f * rmax, ext / (float)FINE_DIM_MAX) * 1.001f;
+    float cell = fmaxf(2.0f * rtyp, ext / (float)FINE_DIM_MAX) * 1.001f;
     g->inv_cell = 1.0f / cell;
     uint32_t cells = 1;
     for (int a = 0; a < 3; a++) {
@@ -123,6 +140,55 @@ static void mark_changed(rs_renderer *r, const rs_makeup_fine_stamp *s, uint32_t
     for (uint32_t k = same; k < n; k++) rs_render_mark_dirty_sphere(r, s[k].pos, s[k].radius);
 }
 
+// The region masks' fields (makeup.c, "Region masks per pixel") stacked along z in one R8 3D texture,
+// filtered linearly: the field between voxels is interpolated, so the mask's level set (the lip line) is
+// smooth. A field never changes once built; a new one (the first stamp kept to a region) redraws all.
+static void upload_fields(rs_renderer *r, const rs_makeup *mk)
+{
+    rs_render_fine *g = &r->fine;
+    const rs_makeup_field *f[RS_COSMETIC_REGION_COUNT];
+    bool same = true;
+    int w = 1, h = 1, d = 0;
+    for (int k = 0; k < RS_COSMETIC_REGION_COUNT; k++) {
+        f[k] = mk ? rs_makeup_region_field(mk, (rs_cosmetic_region)k) : NULL;
+        same = same && (f[k] ? f[k]->value : NULL) == g->field_value[k];
+        if (f[k]) w = RS_MAX(w, f[k]->dim[0]), h = RS_MAX(h, f[k]->dim[1]), d += f[k]->dim[2];
+    }
+    if (same) return;
+    rs_render_invalidate(r);
+    if (g->field_tex) glDeleteTextures(1, &g->field_tex);
+    g->field_tex = 0;
+    memset(g->field_value, 0, sizeof g->field_value);
+    memset(g->field_box, 0, sizeof g->field_box);
+    if (d == 0) return;
+    glGenTextures(1, &g->field_tex);
+    glBindTexture(GL_TEXTURE_3D, g->field_tex);
+    // At most two fields of 128 slices: within GLES 3's least GL_MAX_3D_TEXTURE_SIZE (256).
+    glTexStorage3D(GL_TEXTURE_3D, 1, GL_R8, w, h, d);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    GLint align;
+    glGetIntegerv(GL_UNPACK_ALIGNMENT, &align);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    int z0 = 0;
+    for (int k = 0; k < RS_COSMETIC_REGION_COUNT; k++) {
+        if (!f[k]) continue;
+        const int *n = f[k]->dim;
+        glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, z0, n[0], n[1], n[2], GL_RED, GL_UNSIGNED_BYTE, f[k]->value);
+        float box[8] = {f[k]->origin[0], f[k]->origin[1], f[k]->origin[2], 1.0f / f[k]->voxel,
+                        (float)n[0], (float)n[1], (float)n[2], (float)z0};
+        memcpy(g->field_box[k], box, sizeof box);
+        g->field_ramp[k][0] = f[k]->threshold, g->field_ramp[k][1] = f[k]->band;
+        g->field_value[k] = f[k]->value;
+        z0 += n[2];
+    }
+    glPixelStorei(GL_UNPACK_ALIGNMENT, align);
+    glBindTexture(GL_TEXTURE_3D, 0);
+}
+
 rs_result rs_render_update_fine(rs_renderer *r, const rs_makeup_fine_stamp *s, uint32_t n, const rs_makeup *mk,
                                 rs_error *err)
 {
@@ -130,7 +196,7 @@ rs_result rs_render_update_fine(rs_renderer *r, const rs_makeup_fine_stamp *s, u
     if (n > FINE_STAMPS_MAX)
         return rs_fail(err, RS_ERR_LIMIT, "render: %u fine stamps (at most %u: save the look and clear)", n,
                        FINE_STAMPS_MAX);
-    uint32_t np = rs_makeup_log_cosmetic_count(mk);
+    uint32_t np = mk ? rs_makeup_log_cosmetic_count(mk) : 0;  // no layer: no fine layer (n is 0)
     size_t stamp_texels = 3 * (size_t)n, data_texels = stamp_texels + 3 * (size_t)np, index_texels = 0;
     float *data = rs_alloc_array(RS_MAX(data_texels, 1u), 4 * sizeof(float));
     rs_makeup_fine_stamp *copy = rs_alloc_array(RS_MAX(n, 1u), sizeof *copy);
@@ -142,13 +208,14 @@ rs_result rs_render_update_fine(rs_renderer *r, const rs_makeup_fine_stamp *s, u
     for (uint32_t k = 0; k < n; k++) {
         float v[12] = {s[k].pos[0], s[k].pos[1], s[k].pos[2], s[k].radius,
                        s[k].view_dir[0], s[k].view_dir[1], s[k].view_dir[2], s[k].amount,
-                       (float)s[k].cosmetic, (float)s[k].stroke, (float)s[k].eraser, 0.0f};
+                       (float)s[k].cosmetic, (float)s[k].stroke, (float)s[k].eraser, (float)s[k].region};
         memcpy(data + 12 * (size_t)k, v, sizeof v);
     }
     for (uint32_t i = 0; i < np; i++) product_floats(rs_makeup_log_cosmetic(mk, i), data + 4 * stamp_texels + 12 * (size_t)i);
     // The products are known by index: when one changes (a look replaced), no rectangle says where.
     bool same_products = np == g->last_product_count &&
                          (np == 0 || !memcmp(g->last_products, data + 4 * stamp_texels, (size_t)np * PRODUCT_FLOATS * sizeof(float)));
+    upload_fields(r, mk);
     if (!same_products) rs_render_invalidate(r);
     else if (r->inc_valid) mark_changed(r, s, n);
     if (n) {
@@ -186,13 +253,24 @@ void rs_render_fine_uniforms(const rs_renderer *r, const rs_frame *f, GLuint pro
     glUniform1i(rs_uloc(prog, "u_fine_index"), RS_UNIT_FINE_INDEX);
     rs_render_bind_texture(RS_UNIT_FINE, g->count ? g->data_tex : 0);
     rs_render_bind_texture(RS_UNIT_FINE_INDEX, g->count ? g->index_tex : 0);
+    glUniform1i(rs_uloc(prog, "u_fine_field"), RS_UNIT_FINE_FIELD);
+    glUniform4fv(rs_uloc(prog, "u_fine_field_box"), 2 * RS_COSMETIC_REGION_COUNT, &g->field_box[0][0]);
+    glUniform2fv(rs_uloc(prog, "u_fine_field_ramp"), RS_COSMETIC_REGION_COUNT, &g->field_ramp[0][0]);
+    glActiveTexture(GL_TEXTURE0 + RS_UNIT_FINE_FIELD);
+    glBindTexture(GL_TEXTURE_3D, g->count ? g->field_tex : 0);
+}
+
+void rs_render_fine_unbind(void)
+{
+    glActiveTexture(GL_TEXTURE0 + RS_UNIT_FINE_FIELD);
+    glBindTexture(GL_TEXTURE_3D, 0);
 }
 
 void rs_render_fine_release(rs_renderer *r)
 {
     rs_render_fine *g = &r->fine;
-    GLuint t[2] = {g->data_tex, g->index_tex};
-    glDeleteTextures(2, t);
+    GLuint t[3] = {g->data_tex, g->index_tex, g->field_tex};
+    glDeleteTextures(3, t);
     free(g->last);
     free(g->last_products);
     memset(g, 0, sizeof *g);

@@ -48,6 +48,7 @@ enum {
     RS_UNIT_SPEC_LUT,    // the specular lobe's directional albedo (u_spec_lut)
     RS_UNIT_FINE,        // the fine layer's stamps and products (u_fine_data, RGBA32F)
     RS_UNIT_FINE_INDEX,  // the fine layer's grid: cells (start, count) then stamp lists (u_fine_index, R32UI)
+    RS_UNIT_FINE_FIELD,  // the region masks' fields stacked along z (u_fine_field, R8 3D, linear)
 };
 
 // The fine layer as uploaded (render_fine.c): per-pixel stamps over a model-space grid.
@@ -62,6 +63,10 @@ typedef struct rs_render_fine {
     uint32_t last_count;
     float *last_products;        // 12 floats per product
     uint32_t last_product_count;
+    GLuint field_tex;            // the region fields (rs_makeup_region_field) stacked along z
+    const uint8_t *field_value[RS_COSMETIC_REGION_COUNT];  // the fields uploaded (a field never changes)
+    float field_box[RS_COSMETIC_REGION_COUNT][8];          // (origin, 1 / voxel), (dims, first slice)
+    float field_ramp[RS_COSMETIC_REGION_COUNT][2];         // (threshold, band)
 } rs_render_fine;
 
 #define RS_ENV_LAMPS 3  // env_light.glsl's u_env_lamp_* arrays

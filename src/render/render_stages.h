@@ -25,6 +25,7 @@ void rs_render_shadow_uniforms(const rs_renderer *r, const rs_frame *f, GLuint p
 void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
 // render_fine.c: the fine layer's uniforms and textures for the composite.
 void rs_render_fine_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog);
+void rs_render_fine_unbind(void);  // after the composite: the fields' 3D texture off its unit
 
 // Each part's GL objects (rs_render_destroy and the target resizes).
 void rs_render_shadow_release(rs_renderer *r);
