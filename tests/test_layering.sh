@@ -2,7 +2,7 @@
 # test_layering.sh — src/render/'s dependencies run one way (STYLE.md rule 15), read from the built objects:
 #   render.o (the orchestrator) -> the stages (every other render_*.o) -> the kit (render_kit.o, render_view.o,
 #   profile.o). A stage calls nothing defined in render.o and no sibling's pass (a sibling's *_uniforms
-#   lookup is allowed); the kit calls nothing defined in render.o or in a stage.
+#   lookup, and its *_unbind after the pass, are allowed); the kit calls nothing defined in render.o or in a stage.
 # Usage: sh tests/test_layering.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
 build=${1:-build}
 [ $# -gt 0 ] && shift
@@ -86,7 +86,7 @@ if selected $name; then
         for s in $stages; do
             [ "$s" = "$o" ] && continue
             for f in $(undefined "$o"); do
-                case "$f" in *_uniforms) continue ;; esac
+                case "$f" in *_uniforms|*_unbind) continue ;; esac
                 defined "$s" | grep -qx "$f" && why="$why ${o##*/} calls $f (${s##*/});"
             done
         done
