@@ -130,9 +130,12 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
 }
 
 // Anti-aliased silhouette: a face pixel that touches the background (in its 3x3 neighbourhood) is drawn
-// with coverage (n - 1) / 8 for its n face pixels there, the background showing through the rest. That is
-// a box filter of the face's mask, one pixel wide: a straight edge's last pixel at 5/8, the outer corner of
-// a stair step at 3/8, an inner corner at 7/8, a stray pixel outside the edge gone. The mask is binary and
+// with coverage n / 8 for its n face pixels there (itself included), the background showing through the
+// rest: a straight edge's last pixel at 3/4, the outer corner of a stair step at 1/2, an inner corner
+// whole, a stray pixel outside the edge gone. A mask pixel's centre is on the face, so the edge runs
+// between it and the next centre out: its coverage is 1/2 to 1, 3/4 on average on a straight edge (the
+// box filter's (n - 1) / 8, 5/8 there, drew a dark ring half a pixel inside the path tracer's outline,
+// issue 22: the silhouette's first full pixel at 0.50 of its luminance in studio, 0.55 now). The mask is binary and
 // stable from frame to frame, so the edge is smooth without the speckle the splats' own (noisy) weights
 // give; pixels with no background near are untouched.
 // How much of the sky a pixel seen edge-on still reflects. At a contour in front of more face (the
@@ -182,7 +185,7 @@ float coverage(ivec2 px)
     int n = 9;
     for (int i = 0; i < 9; i++)
         if (i != 4 && uncovered(px + ivec2(i % 3 - 1, i / 3 - 1)) && background_at(px + ivec2(i % 3 - 1, i / 3 - 1))) n--;
-    return n == 9 ? 1.0 : float(n - 1) / 8.0;
+    return n <= 1 ? 0.0 : min(float(n) / 8.0, 1.0);
 }
 
 void main()
