@@ -13,6 +13,7 @@ precision highp int;
 #include "shadow_lookup.glsl"
 #include "skin_brdf.glsl"
 #include "env_light.glsl"
+#include "bounce.glsl"
 #include "makeup_fine.glsl"
 
 // Same numbering as rs_render_mode in render.h.
@@ -174,9 +175,12 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
 }
 
 // Anti-aliased silhouette: a face pixel that touches the background (in its 3x3 neighbourhood) is drawn
-// with coverage (n - 1) / 8 for its n face pixels there, the background showing through the rest. That is
-// a box filter of the face's mask, one pixel wide: a straight edge's last pixel at 5/8, the outer corner of
-// a stair step at 3/8, an inner corner at 7/8, a stray pixel outside the edge gone. The mask is binary and
+// with coverage n / 8 for its n face pixels there (itself included), the background showing through the
+// rest: a straight edge's last pixel at 3/4, the outer corner of a stair step at 1/2, an inner corner
+// whole, a stray pixel outside the edge gone. A mask pixel's centre is on the face, so the edge runs
+// between it and the next centre out: its coverage is 1/2 to 1, 3/4 on average on a straight edge (the
+// box filter's (n - 1) / 8, 5/8 there, drew a dark ring half a pixel inside the path tracer's outline,
+// issue 22: the silhouette's first full pixel at 0.50 of its luminance in studio, 0.55 now). The mask is binary and
 // stable from frame to frame, so the edge is smooth without the speckle the splats' own (noisy) weights
 // give; pixels with no background near are untouched.
 // How much of the sky a pixel seen edge-on still reflects. At a contour in front of more face (the
@@ -226,7 +230,7 @@ float coverage(ivec2 px)
     int n = 9;
     for (int i = 0; i < 9; i++)
         if (i != 4 && uncovered(px + ivec2(i % 3 - 1, i / 3 - 1)) && background_at(px + ivec2(i % 3 - 1, i / 3 - 1))) n--;
-    return n == 9 ? 1.0 : float(n - 1) / 8.0;
+    return n <= 1 ? 0.0 : min(float(n) / 8.0, 1.0);
 }
 
 void main()
@@ -275,7 +279,7 @@ void main()
                + u_ambient;
         // The makeup's clear coat: the same lobe family, smooth (m 0.1), F0 0.04, untinted, on top.
         const float mc = 0.1;
-        vec3 C = vec3(0.0);
+        vec3 C = vec3(0.0), Eb = vec3(0.0);
         if (coat > 0.0)
             C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
                                * shadow);
@@ -285,6 +289,9 @@ void main()
             float ndotv = dot(N, V);
             float so = ao * contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv));
             E += rs_env_irradiance(N) * ao;
+            // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
+            // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
+            Eb = rs_bounce(ao, A);
             S += rs_env_specular(N, V, m, RS_F0_SKIN) * (rho_s * so);
             if (coat > 0.0) C += rs_env_specular(N, V, mc, RS_F0_COAT) * so;
         }
@@ -299,6 +306,8 @@ void main()
         // [0.8, 1.25] of the narrowest drawn level's splat-averaged irradiance (its luminance, in D's
         // alpha), keeping E's colour. Surfaces facing the eye keep their per-pixel E untouched: normal-map
         // detail and the sharp green/blue shadow edges stay.
+        vec3 El = E;  // the lights' own colour, before the skin's bounce tints it
+        E += Eb;
         vec3 Ed = E;
         float es = D.a * u_diffuse_scale;
         float edge_on = 1.0 - smoothstep(0.15, 0.45, dot(N, V));
@@ -310,10 +319,10 @@ void main()
         vec3 Dd = D.rgb * u_diffuse_scale + u_delta_weight * Ed;
         // Across a fold (the alar groove, a lid crease) the drawn levels' widest, reddest Gaussians gather
         // light from the lit side of the groove; seen edge-on, that bleed reads as a thin red line. There
-        // D's red is held within 1.25 x its green, relative to the light's own colour (Ed: a sunset's
-        // orange stays orange).
+        // D's red is held within 1.25 x its green, relative to the light's own colour (El: a sunset's
+        // orange stays orange; the bounce's red is the skin's, the very bleed this holds back).
         if (edge_on > 0.0) {
-            float k = 1.25 * (Ed.r + 1e-4) / (Ed.g + 1e-4);
+            float k = 1.25 * (El.r + 1e-4) / (El.g + 1e-4);
             Dd.r = mix(Dd.r, min(Dd.r, k * Dd.g), edge_on);
         }
         if (u_mode == MODE_DIFFUSE) c = A * Dd;

@@ -2,8 +2,9 @@
 // irradiance.vert.glsl — stage 4's per-splat input, computed once per frame by transform feedback (no
 // rasterisation) so the diffusion levels don't repeat the shadow-map PCF: each splat's irradiance
 // E = key (N.L, shadow-mapped) + fill (N.L) + ambient + the environment's SH irradiance times the splat's
-// ambient occlusion (so stage 4 scatters environment light like the key light), and how far it lies
-// behind the visible surface when
+// ambient occlusion (so stage 4 scatters environment light like the key light) + the light the skin around
+// it bounces into what the occlusion hides (bounce.glsl; the splat's own scanned albedo stands for its
+// surroundings', never the makeup's), and how far it lies behind the visible surface when
 // it faces away (the back of the head: the levels skip it when that exceeds their kernel's reach).
 precision highp float;
 precision highp int;
@@ -11,6 +12,7 @@ precision highp int;
 #include "shadow_lookup.glsl"
 #include "skin_brdf.glsl"  // env_light.glsl weighs its taps with the lobe
 #include "env_light.glsl"
+#include "bounce.glsl"
 
 layout(location = 0) in uvec4 a_splat;
 uniform mat4 u_view;
@@ -67,7 +69,9 @@ void main()
     bool unseen = behind > u_reach || outside_view(c) > u_reach;
     if (dot(e, e) > 0.0 && !unseen) e *= rs_shadow(c, n);
     e += u_fill_color * max(dot(n, u_fill_dir), 0.0) + u_ambient;
-    if (u_env_on > 0.5) e += rs_env_irradiance(n) * s.ao;
+    if (u_env_on > 0.5)
+        e += rs_env_irradiance(n) * s.ao
+           + rs_bounce(s.ao, s.albedo);
     v_irradiance = vec4(e, behind);
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
     gl_PointSize = 1.0;

@@ -13,8 +13,11 @@
 #define LUT_SAMPLES 512
 // Linear RGB -> luminance (Rec. 709).
 #define LUM(c) (0.2126f * (c)[0] + 0.7152f * (c)[1] + 0.0722f * (c)[2])
-// What the normalisation aims at: the mean irradiance over the front-facing half of the normals.
-#define ENV_TARGET_FRONT 0.5f
+// What the normalisation aims at: the mean irradiance of the face's surface as a camera in front sees it
+// (facing_irradiance). 0.53 keeps the bundled environments' mean brightness what it was when they were
+// normalised over the front half-space of normals uniformly (0.5 then), which left a surface facing the
+// camera lit from 0.48 (office) to 0.71 (studio); now the face's picture gets the same light in each.
+#define ENV_TARGET_FRONT 0.53f
 
 // Directional albedo of the lobe S = (N.L) P_H F / |L + V|^2 (rho_s 1) over the hemisphere, divided by pi
 // as every light in the renderer is (a white Lambertian surface under irradiance E reflects E): F0 A + B.
@@ -167,22 +170,43 @@ done:
     free(sr);
 }
 
-// Mean luminance of the irradiance (SH + the dominant light) over normals of the front half-space, by a
-// fixed spiral of directions: what the face mostly shows.
-static float front_irradiance(const rs_env *env)
+// Mean irradiance (SH + the dominant light + `lamps` more lamps) of the skin facing direction fwd
+// (environment frame), as a camera looking along -fwd sees it: normals spread over the hemisphere around
+// fwd in proportion to the area they fill in its picture, cos(angle to fwd) (a sphere's picture), by a
+// fixed spiral of directions.
+static void facing_irradiance(const float sh[9][3], const float light_dir[3], const float light_color[3],
+                              const float (*lamp_dir)[3], const float (*lamp_color)[3], int lamps,
+                              const float fwd[3], float out[3])
 {
     const int n = 256;
-    double sum = 0.0;
+    // An orthonormal frame (t, b, fwd).
+    float t[3] = {fwd[2], 0.0f, -fwd[0]};
+    float tl = sqrtf(t[0] * t[0] + t[2] * t[2]);
+    if (tl < 1e-6f) t[0] = 1.0f, t[2] = 0.0f, tl = 1.0f;
+    for (int c = 0; c < 3; c++) t[c] /= tl;
+    float b[3] = {fwd[1] * t[2] - fwd[2] * t[1], fwd[2] * t[0] - fwd[0] * t[2], fwd[0] * t[1] - fwd[1] * t[0]};
+    double sum[3] = {0.0, 0.0, 0.0};
     for (int i = 0; i < n; i++) {
-        float z = ((float)i + 0.5f) / (float)n;  // forward component, uniform over the hemisphere
+        float z = sqrtf(((float)i + 0.5f) / (float)n);  // cosine-weighted over the hemisphere
         float s = sqrtf(1.0f - z * z), phi = 2.39996323f * (float)i;
-        float d[3] = {s * cosf(phi), s * sinf(phi), z}, e[3];
-        rs_env_sh_irradiance(env, d, e);
-        float nl = RS_MAX(d[0] * env->light_dir[0] + d[1] * env->light_dir[1] + d[2] * env->light_dir[2], 0.0f);
-        for (int c = 0; c < 3; c++) e[c] += env->light_color[c] * nl;
-        sum += LUM(e);
+        float u = s * cosf(phi), v = s * sinf(phi), d[3], e[3];
+        for (int c = 0; c < 3; c++) d[c] = u * t[c] + v * b[c] + z * fwd[c];
+        float y[9];
+        rs_env_sh_basis(d, y);
+        for (int c = 0; c < 3; c++) {
+            e[c] = 0.0f;
+            for (int k = 0; k < 9; k++) e[c] += sh[k][c] * y[k];
+            e[c] = RS_MAX(e[c], 0.0f);
+        }
+        float nl = RS_MAX(d[0] * light_dir[0] + d[1] * light_dir[1] + d[2] * light_dir[2], 0.0f);
+        for (int c = 0; c < 3; c++) e[c] += light_color[c] * nl;
+        for (int k = 0; k < lamps; k++) {
+            float kl = RS_MAX(d[0] * lamp_dir[k][0] + d[1] * lamp_dir[k][1] + d[2] * lamp_dir[k][2], 0.0f);
+            for (int c = 0; c < 3; c++) e[c] += lamp_color[k][c] * kl;
+        }
+        for (int c = 0; c < 3; c++) sum[c] += e[c];
     }
-    return (float)(sum / n);
+    for (int c = 0; c < 3; c++) out[c] = (float)(sum[c] / n);
 }
 
 rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
@@ -221,7 +245,10 @@ rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
     }
     rs_render_env *e = &r->env;
     e->on = true;
-    float front = front_irradiance(env);
+    const float fwd[3] = {0.0f, 0.0f, 1.0f};  // the face frame's forward: the face seen from the front
+    float fe[3];
+    facing_irradiance(env->sh, env->light_dir, env->light_color, NULL, NULL, 0, fwd, fe);  // lamps still in the SH
+    float front = LUM(fe);
     e->scale = front > 1e-6f ? ENV_TARGET_FRONT / front : 1.0f;
     memcpy(e->sh, env->sh, sizeof e->sh);
     find_lamps(env, e);
@@ -263,6 +290,15 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
     glUniform1fv(rs_uloc(prog, "u_env_m"), RS_ENV_MAX_LEVELS, r->env.level_m);
     glUniform1i(rs_uloc(prog, "u_env_levels"), r->env.levels);
     glUniform1f(rs_uloc(prog, "u_env_scale"), r->env.scale * e);
+    // What the skin around a hollow is lit by, on average (bounce.glsl): the face's own front surface
+    // (its forward turned into the environment's frame with the environment), SH and light together.
+    float a = f->view.env_rotate_deg * 0.017453293f;
+    const float fwd[3] = {-sinf(a), 0.0f, cosf(a)};
+    float surround[3];
+    facing_irradiance(r->env.sh, r->env.light_dir, r->env.light_color, (const float (*)[3])r->env.lamp_dir,
+                      (const float (*)[3])r->env.lamp_color, RS_ENV_LAMPS, fwd, surround);
+    for (int c = 0; c < 3; c++) surround[c] *= e;
+    glUniform3fv(rs_uloc(prog, "u_env_surround"), 1, surround);
 }
 
 void rs_render_env_release(rs_renderer *r)

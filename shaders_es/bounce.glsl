@@ -1,0 +1,26 @@
+// bounce.glsl — light between skin surfaces, from the per-splat ambient occlusion (the converter's
+// cosine-weighted sky visibility). The part of the hemisphere the occlusion takes away is not black: it
+// is skin (the neck under the jaw, the cheek beside the nose, the other lip), lit by the same lights and
+// reflecting them in its own colour, bounce after bounce. Jimenez et al. 2016 (GTAO, "multi-bounce")
+// fitted the visibility that light from a uniform sky reaches after all those bounces in a cavity of
+// albedo a, as a cubic in the visibility v per colour channel. Here the bounced part (fit - v) is lit by
+// what lights the skin around a hollow, taken as the face's front surface on average (u_env_surround,
+// render_env.c: its mean irradiance, SH and the environment's light, as a camera in front sees it). So a
+// crease gets light in the skin's colour (red-brown under red-brown skin), and an underside facing a dark
+// floor (under the jaw) is lit by the skin that faces the light.
+uniform vec3 u_env_surround;
+
+// Visibility after interreflections: >= v; per channel, for the cavity's albedo (linear RGB).
+vec3 rs_multibounce(float v, vec3 albedo)
+{
+    vec3 a = 2.0404 * albedo - 0.3324;
+    vec3 b = -4.7951 * albedo + 0.6417;
+    vec3 c = 2.7552 * albedo + 0.6903;
+    return max(vec3(v), ((v * a + b) * v + c) * v);
+}
+
+// Irradiance that reaches a point of visibility v from the skin around it (albedo: its colour).
+vec3 rs_bounce(float v, vec3 albedo)
+{
+    return (rs_multibounce(v, clamp(albedo, 0.0, 1.0)) - v) * u_env_surround;
+}
