@@ -28,15 +28,22 @@ order=""
 for t in $slow; do case " $all " in *" $t "*) order="$order $t" ;; esac; done
 for t in $all; do case " $slow $alone " in *" $t "*) ;; *) order="$order $t" ;; esac; done
 
-# One test: its output to LOGS/NAME.log, its exit status to LOGS/NAME.rc.
+# One test: its output to LOGS/NAME.log, closed by a line "# TEST: W s wall, C s CPU" (C: user + system
+# seconds of everything it waited for, from the shell's `times`), and its exit status to LOGS/NAME.rc.
 export logs build
 export RS_FILTERS="$*"
 one='t={}; n=$(echo "$t" | tr / _)
+    start=$(date +%s.%N)
     case "$t" in
         *.sh) sh "$t" "$build" $RS_FILTERS ;;
         *) "$t" $RS_FILTERS ;;
     esac > "$logs/$n.log" 2>&1
-    echo $? > "$logs/$n.rc"'
+    echo $? > "$logs/$n.rc"
+    end=$(date +%s.%N)
+    times > "$logs/$n.times"
+    awk -v t="$t" -v s="$start" -v e="$end" "NR == 2 { split(\$0, f, /[ms]+/)
+        printf \"# %s: %.1f s wall, %.1f s CPU\\n\", t, e - s, f[1] * 60 + f[2] + f[3] * 60 + f[4] }" \
+        "$logs/$n.times" >> "$logs/$n.log"'
 # shellcheck disable=SC2086
 printf '%s\n' $order | xargs -P "$jobs" -I{} sh -c "$one"
 for t in $alone; do case " $all " in *" $t "*) printf '%s\n' "$t" | xargs -I{} sh -c "$one" ;; esac; done
@@ -58,4 +65,8 @@ f=$(cat "$logs"/*.log | grep -c '^FAIL - ')
 s=$(cat "$logs"/*.log | grep -c '^skip - ')
 [ "$f" -gt 0 ] && status=1
 echo "$p passed, $f failed, $s skipped"
+# What the time went to: the CPU seconds of all tests (what the cores must share) and the slowest ones.
+sed -n 's/^# \(.*\): \([0-9.]*\) s wall, \([0-9.]*\) s CPU$/\3 \2 \1/p' "$logs"/*.log | sort -n -r | awk '
+    { cpu += $1; if (NR <= 8) top = top sprintf("#   %6.1f s CPU %6.1f s wall  %s\n", $1, $2, $3) }
+    END { printf "# %.0f s CPU in all tests; the slowest:\n%s", cpu, top }'
 exit $status
