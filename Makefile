@@ -52,8 +52,8 @@ SOMAJOR  := 0
 SONAME   := librouge.so.$(SOMAJOR)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 
-.PHONY: all deps run test bench asan fuzz figures envs clean install uninstall import-fixtures web web-deps truth \
-        truth-deps
+.PHONY: all deps run test test-full bench asan fuzz figures envs clean install uninstall import-fixtures web web-deps \
+        truth truth-deps
 all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES) $(BUILD)/rouge-truth-scene
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
@@ -263,6 +263,13 @@ test: deps web-deps
 	@$(MAKE) --no-print-directory all
 	@$(MAKE) --no-print-directory web
 	@sh tests/run.sh $(BUILD)
+
+# make test plus the slow extras it leaves out to stay within minutes: valgrind on the bundled 600k face
+# (make test runs the same render under valgrind on a 3000-splat face).
+test-full: deps web-deps
+	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory web
+	@RS_VALGRIND_FACE=1 sh tests/run.sh $(BUILD)
 
 # The test suite under AddressSanitizer + UndefinedBehaviorSanitizer, in its own build directory.
 asan: deps

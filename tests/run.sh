@@ -2,7 +2,8 @@
 # Runs every test program (build/tests/test_*) and script (tests/test_*.sh) and sums up their
 # "ok"/"FAIL"/"skip" lines into the closing "N passed, N failed, N skipped" line.
 # Tests run RS_TEST_JOBS at a time (default: the number of cores), the longest first so the short ones
-# fill in beside them; each one's output is printed whole, in name order, once all have run.
+# fill in beside them (a program's slowest checks may run as jobs of their own: $split below); each one's
+# output is printed whole, in name order, once all have run, and the run ends with the CPU seconds spent.
 # Usage: tests/run.sh [BUILD_DIR] [NAME_FILTER...]
 build=${1:-build}
 [ $# -gt 0 ] && shift
@@ -24,26 +25,50 @@ for t in "$build"/tests/test_* tests/test_*.sh; do
     case "$t" in *.d|*.o) continue ;; esac
     all="$all $t"
 done
+# Programs whose slowest checks run as jobs of their own, beside the rest of the program (the harness's
+# "-SUB" leaves them out of it): PROGRAM=SUB,SUB... Only without a name filter.
+split="$build/tests/test_mobile=tolerance_at_512,under_environments"
+# jobs_of TEST: its jobs, TEST or TEST+ARG+ARG... (the arguments replace the name filter).
+jobs_of() {
+    t=$1
+    shift
+    for s in $split; do
+        [ $# -eq 0 ] && [ "${s%%=*}" = "$t" ] || continue
+        rest=$t
+        for sub in $(echo "${s#*=}" | tr , ' '); do echo "$t+$sub"; rest="$rest+-$sub"; done
+        echo "$rest"
+        return
+    done
+    echo "$t"
+}
 order=""
-for t in $slow; do case " $all " in *" $t "*) order="$order $t" ;; esac; done
-for t in $all; do case " $slow $alone " in *" $t "*) ;; *) order="$order $t" ;; esac; done
+for t in $slow; do case " $all " in *" $t "*) order="$order $(jobs_of "$t" "$@")" ;; esac; done
+for t in $all; do case " $slow $alone " in *" $t "*) ;; *) order="$order $(jobs_of "$t" "$@")" ;; esac; done
 
-# One test: its output to LOGS/NAME.log, its exit status to LOGS/NAME.rc.
+# One test: its output to LOGS/NAME.log, closed by a line "# TEST: W s wall, C s CPU" (C: user + system
+# seconds of everything it waited for, from the shell's `times`), and its exit status to LOGS/NAME.rc.
 export logs build
 export RS_FILTERS="$*"
-one='t={}; n=$(echo "$t" | tr / _)
-    case "$t" in
-        *.sh) sh "$t" "$build" $RS_FILTERS ;;
-        *) "$t" $RS_FILTERS ;;
+one='t={}; n=$(echo "$t" | tr /+ __) p=${t%%+*} args=$RS_FILTERS
+    case "$t" in *+*) args=$(echo "${t#*+}" | tr + " ") ;; esac
+    start=$(date +%s.%N)
+    case "$p" in
+        *.sh) sh "$p" "$build" $args ;;
+        *) "$p" $args ;;
     esac > "$logs/$n.log" 2>&1
-    echo $? > "$logs/$n.rc"'
+    echo $? > "$logs/$n.rc"
+    end=$(date +%s.%N)
+    times > "$logs/$n.times"
+    awk -v t="$t" -v s="$start" -v e="$end" "NR == 2 { split(\$0, f, /[ms]+/)
+        printf \"# %s: %.1f s wall, %.1f s CPU\\n\", t, e - s, f[1] * 60 + f[2] + f[3] * 60 + f[4] }" \
+        "$logs/$n.times" >> "$logs/$n.log"'
 # shellcheck disable=SC2086
 printf '%s\n' $order | xargs -P "$jobs" -I{} sh -c "$one"
 for t in $alone; do case " $all " in *" $t "*) printf '%s\n' "$t" | xargs -I{} sh -c "$one" ;; esac; done
 
 status=0
-for t in $all; do
-    n=$(echo "$t" | tr / _)
+for t in $(for a in $all; do jobs_of "$a" "$@"; done); do
+    n=$(echo "$t" | tr /+ __)
     echo "# $t"
     cat "$logs/$n.log"
     rc=$(cat "$logs/$n.rc" 2>/dev/null || echo 1)
@@ -58,4 +83,8 @@ f=$(cat "$logs"/*.log | grep -c '^FAIL - ')
 s=$(cat "$logs"/*.log | grep -c '^skip - ')
 [ "$f" -gt 0 ] && status=1
 echo "$p passed, $f failed, $s skipped"
+# What the time went to: the CPU seconds of all tests (what the cores must share) and the slowest ones.
+sed -n 's/^# \(.*\): \([0-9.]*\) s wall, \([0-9.]*\) s CPU$/\3 \2 \1/p' "$logs"/*.log | sort -n -r | awk '
+    { cpu += $1; if (NR <= 8) top = top sprintf("#   %6.1f s CPU %6.1f s wall  %s\n", $1, $2, $3) }
+    END { printf "# %.0f s CPU in all tests; the slowest:\n%s", cpu, top }'
 exit $status

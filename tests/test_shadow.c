@@ -10,7 +10,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define SIZE 512
+// The wall views: the middle half (rows 128..383) of a 512x512 view at zoom 1.2 and fov 30, 8.2 px/mm: every
+// pixel the edge and the acne band read, at half the pixels. The same camera distance (zoom 2.4 with the
+// narrower fov below), so the same projection of the scene; the pan in view heights moves it the same 102 px.
+#define W 512
+#define H 256
 #define MM_PER_UNIT 47.0f  // the bundled head's scale
 #define WALL_H 20.0f       // mm: the top row of wall splats sits here (plus 0.1 k, below)
 #define RADIUS 0.95f       // mm: the bundled head's median splat radius
@@ -87,11 +91,12 @@ static bool shadow_edge_mm(rs_renderer *r, const rs_view *v, const rs_image *img
 static bool wall_edge(rs_renderer *r, rs_pipeline pipeline, float wall_h, float theta, float *off_mm, int *acne)
 {
     rs_view v = rs_view_defaults();
-    v.width = v.height = SIZE;
+    v.width = W, v.height = H;
     v.mode = RS_MODE_SHADOW;
     v.pipeline = pipeline;
-    v.zoom = 1.2f;
-    v.pan[0] = 0.2f;
+    v.fov_deg = 2.0f * atanf(tanf(15.0f * 3.14159265f / 180.0f) * H / W) * 180.0f / 3.14159265f;
+    v.zoom = 1.2f * W / H;
+    v.pan[0] = 0.2f * W / H;
     v.key.yaw_deg = theta, v.key.pitch_deg = 0;
     rs_image img = {0};
     rs_error err = {0};
@@ -106,12 +111,12 @@ static bool wall_edge(rs_renderer *r, rs_pipeline pipeline, float wall_h, float 
     int bad = 0, n = 0;
     if (rs_render_project(r, &v, o, q0) && rs_render_project(r, &v, a, qa)) {
         float px_per_mm = (q0[0] - qa[0]) / 30.0f;
-        for (int y = SIZE / 4; y < 3 * SIZE / 4; y++)
-            for (int x = 0; x < SIZE; x++) {
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
                 float mm = ((float)x + 0.5f - q0[0]) / px_per_mm;
                 if (mm < 2.0f || mm > 38.0f) continue;
                 n++;
-                bad += img.pixels[((size_t)y * SIZE + x) * 4] < 252;
+                bad += img.pixels[((size_t)y * W + x) * 4] < 252;
             }
     }
     *acne = n > 1000 ? bad : -1;

@@ -7,8 +7,8 @@
 # through those libraries.
 #
 # Kept small to fit `make test` (~30 s on 2 cores): the render uses a 3000-splat face converted here.
-# RS_VALGRIND_FACE=1 adds the bundled 600k face at --max-splats 2000 (~90 s: loading and uploading 600k
-# splats under valgrind); docs/robustness.md records its result.
+# RS_VALGRIND_FACE=1 (make test-full) adds the bundled 600k face at --max-splats 2000 (~90 s: loading and
+# uploading 600k splats under valgrind); docs/robustness.md records its result.
 # Usage: sh tests/test_valgrind.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
 build=${1:-build}
 [ $# -gt 0 ] && shift
@@ -118,6 +118,6 @@ if [ "${RS_VALGRIND_FACE:-0}" = 1 ]; then
     memcheck valgrind_render_bundled_face 0 "$rouge" render assets/face.rsf --size 32x32 --max-splats 2000 \
         -o "$tmp/face.png"
 elif selected valgrind_render_bundled_face; then
-    echo "skip - valgrind_render_bundled_face: ~90 s; run with RS_VALGRIND_FACE=1"
+    echo "skip - valgrind_render_bundled_face: ~90 s; make test-full runs it (RS_VALGRIND_FACE=1)"
 fi
 exit 0

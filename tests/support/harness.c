@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <time.h>
 #include <unistd.h>
 
 static struct {
@@ -27,12 +28,21 @@ void rs_test_init(int argc, char **argv)
     setvbuf(stdout, NULL, _IOLBF, 0);
 }
 
+// argv[1..]: substrings selecting tests; "-SUBSTRING" leaves out the tests it matches (tests/run.sh runs the
+// slowest checks of a program as jobs of their own beside the rest).
 static bool selected(const char *name)
 {
-    if (T.argc <= 1) return true;
-    for (int i = 1; i < T.argc; i++)
-        if (strstr(name, T.argv[i])) return true;
-    return false;
+    bool any = false, hit = false;
+    for (int i = 1; i < T.argc; i++) {
+        const char *a = T.argv[i];
+        if (a[0] == '-') {
+            if (a[1] && strstr(name, a + 1)) return false;
+        } else {
+            any = true;
+            hit = hit || strstr(name, a);
+        }
+    }
+    return !any || hit;
 }
 
 void rs_test_run(const char *name, void (*fn)(void))
@@ -41,8 +51,9 @@ void rs_test_run(const char *name, void (*fn)(void))
     T.cur_failed = T.cur_skipped = false;
     T.cur_msg[0] = 0;
     double t0 = rs_time_now();
+    clock_t c0 = clock();  // the process's CPU time, every thread (llvmpipe's too): what a busy machine cannot skew
     fn();
-    double dt = rs_time_now() - t0;
+    double dt = rs_time_now() - t0, cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
     if (T.cur_failed) {
         T.failed++;
         printf("FAIL - %s: %s\n", name, T.cur_msg);
@@ -51,7 +62,7 @@ void rs_test_run(const char *name, void (*fn)(void))
         printf("skip - %s: %s\n", name, T.cur_msg);
     } else {
         T.passed++;
-        printf("ok - %s (%.2f s)\n", name, dt);
+        printf("ok - %s (%.2f s, %.2f s CPU)\n", name, dt, cpu);
     }
 }
 

@@ -15,7 +15,7 @@
 #include "core/core.h"
 #include "core/image.h"
 
-void rs_test_init(int argc, char **argv);  // argv[1..]: substrings selecting tests to run
+void rs_test_init(int argc, char **argv);  // argv[1..]: substrings selecting tests to run; "-SUB" leaves out those matching SUB
 void rs_test_run(const char *name, void (*fn)(void));
 int rs_test_finish(void);
 #define RS_RUN(fn) rs_test_run(#fn, fn)

@@ -417,7 +417,8 @@ rs_result rs_env_prefilter(const rs_envmap *full, rs_env_level *lvl, float m, rs
             rs_envmap_texel_dir(lvl->width, lvl->height, oi, oj, R);
             double phi_r = 2 * PI * ((oi + 0.5) / lvl->width - 0.5);
             int ic = (int)floor((phi_r / (2 * PI) + 0.5) * sw);
-            double acc[3] = {0, 0, 0}, wsum = 0;
+            // (Three scalars, not an array: the compiler keeps them in registers in the inner loop.)
+            double acc0 = 0, acc1 = 0, acc2 = 0, wsum = 0;
             for (int j = j0; j <= j1; j++) {
                 // Columns of this row inside the cap: cos(dphi) >= (cos reach - cos t cos tr) / (sin t sin tr).
                 int half = sw / 2;
@@ -429,8 +430,9 @@ rs_result rs_env_prefilter(const rs_envmap *full, rs_env_level *lvl, float m, rs
                     if (cd > -1) half = RS_MIN(half, (int)ceil(acos(cd) / texel) + 1);
                 }
                 int i_end = half == sw / 2 ? ic + sw - half : ic + half + 1;
+                // ii runs within half a turn of ic (0 <= ic <= sw): one wrap at most, no division per texel.
                 for (int ii = ic - half; ii < i_end; ii++) {
-                    int i = ((ii % sw) + sw) % sw;
+                    int i = ii < 0 ? ii + sw : ii >= sw ? ii - sw : ii;
                     size_t t = (size_t)j * sw + i;
                     float rl = dot3(R, dirs + t * 3);
                     if (rl <= rl0) continue;
@@ -438,10 +440,11 @@ rs_result rs_env_prefilter(const rs_envmap *full, rs_env_level *lvl, float m, rs
                     int k = RS_MIN((int)x, TABLE - 1);
                     float wgt = (table[k] + (x - (float)k) * (table[k + 1] - table[k])) * row_sr[j];
                     const float *c = src.rgb + t * 3;
-                    for (int k = 0; k < 3; k++) acc[k] += c[k] * wgt;
+                    acc0 += c[0] * wgt, acc1 += c[1] * wgt, acc2 += c[2] * wgt;
                     wsum += wgt;
                 }
             }
+            double acc[3] = {acc0, acc1, acc2};
             float out[3];
             for (int k = 0; k < 3; k++) out[k] = wsum > 0 ? (float)(acc[k] / wsum) : 0.0f;
             lvl->rgb9e5[(size_t)oj * lvl->width + oi] = rs_rgb9e5_pack(out);
