@@ -62,6 +62,15 @@ if [ -f "$tmp/triangle.info" ]; then
         echo "FAIL - corpus_flat_model_seen_face_on: $(grep forward "$tmp/triangle.info")"
     fi
 fi
+# A model from a z-up exporter standing on z (a post 1 x 0.6 x 4): framed z up, not seen from its top.
+{
+    printf 'v 0 0 0\nv 1 0 0\nv 1 0.6 0\nv 0 0.6 0\nv 0 0 4\nv 1 0 4\nv 1 0.6 4\nv 0 0.6 4\n'
+    printf 'f 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n'
+} >"$tmp/post.obj"
+if convert post "$tmp/post.obj" 4000; then
+    if grep -q '^ *up *(0.0000 0.0000 1.0000)' "$tmp/post.info"; then echo "ok - corpus_z_up_model_stands_on_z"
+    else echo "FAIL - corpus_z_up_model_stands_on_z: $(grep '^ *up' "$tmp/post.info")"; fi
+fi
 a_face head_obj tests/fixtures/import/head/head.obj 20000
 
 # A file that is no model: one clean line, exit 1, nothing written.

@@ -473,8 +473,8 @@ static void bounds_frame(const float (*pos)[3], uint32_t count, rs_pack_face *f)
 
 // The frame of a model without a face and without axes given: +y up and +z forward (the convention of
 // glTF, OBJ and most exporters), except that a flat model (one bounding-box side under a third of the
-// next) is seen face-on, along its thin axis, and a model whose z side is the longest by 1.5x while y is
-// the shortest (a z-up figure, a z-up exporter's upright model) stands on z.
+// next) is seen face-on, along its thin axis, and a model whose z side is over 3x the others while y is
+// the shortest (a standing figure from a z-up exporter; a y-up car, 2.5x, is not one) stands on z.
 static void plain_axes(const float (*pos)[3], uint32_t count, rs_pack_face *f)
 {
     float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
@@ -491,7 +491,7 @@ static void plain_axes(const float (*pos)[3], uint32_t count, rs_pack_face *f)
     if (e[thin] < mid / 3) {
         if (thin == 0) fw[2] = 0, fw[0] = 1;                      // a wall in yz: from +x
         else if (thin == 1) up[1] = 0, up[2] = -1, fw[2] = 0, fw[1] = 1;  // lying in xz: from above, +z down
-    } else if (e[2] > 1.5f * fmaxf(e[0], e[1]) && e[1] <= e[0]) {
+    } else if (e[2] > 3.0f * fmaxf(e[0], e[1]) && e[1] <= e[0]) {
         up[1] = 0, up[2] = 1, fw[2] = 0, fw[1] = -1;  // z up, looking along -y (Blender's front view)
     }
     memcpy(f->up, up, sizeof up);
