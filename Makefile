@@ -52,8 +52,8 @@ SOMAJOR  := 0
 SONAME   := librouge.so.$(SOMAJOR)
 EXAMPLES := $(patsubst examples/%.c,$(BUILD)/examples/%,$(sort $(wildcard examples/*.c)))
 
-.PHONY: all deps run test test-full bench asan fuzz figures envs clean install uninstall import-fixtures web web-deps \
-        truth truth-deps
+.PHONY: all deps run test test-full corpus bench asan fuzz figures envs clean install uninstall import-fixtures web \
+        web-deps truth truth-deps
 all: $(PROGS) $(TESTS) $(BUILD)/$(SONAME) $(EXAMPLES) $(BUILD)/rouge-truth-scene
 
 # Installs what is missing (Debian packages), saying what and why; see tools/deps.sh.
@@ -278,6 +278,14 @@ asan: deps
 	    EXTRA_LDFLAGS='-fsanitize=address,undefined' all
 	@ASAN_OPTIONS=detect_leaks=1:abort_on_error=0 LSAN_OPTIONS=suppressions=$(CURDIR)/tests/lsan.supp:print_suppressions=0 \
 	    UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 sh tests/run.sh build-asan
+
+# The larger third-party corpus (tests/corpus.sh): ../shared/data and assimp's test models (Debian's
+# assimp-testmodels, 20 MB, installed here only: make test's fixtures are in tests/fixtures/corpus).
+corpus: deps
+	@dpkg -s assimp-testmodels >/dev/null 2>&1 || { echo "corpus: installing assimp-testmodels (assimp's BSD test models)"; \
+	    $$( [ "$$(id -u)" -eq 0 ] || echo sudo ) apt-get install -y assimp-testmodels; }
+	@$(MAKE) --no-print-directory all
+	@sh tests/corpus.sh $(BUILD)
 
 bench: deps
 	@$(MAKE) --no-print-directory all

@@ -366,8 +366,14 @@ static void print_summary(const options *o, const rs_splat_cloud *c, const rs_pa
     if (f->found) {
         printf("  face          nose tip (%.3f %.3f %.3f), mouth (%.3f %.3f %.3f), height %.3f units\n", f->nose_tip[0],
                f->nose_tip[1], f->nose_tip[2], f->mouth[0], f->mouth[1], f->mouth[2], f->face_height);
+        printf("  confidence    %.2f (symmetry %.2f, nose %.2f, eyes %.2f, mouth %.2f; a face needs %.2f)\n", f->confidence,
+               f->evidence[0], f->evidence[1], f->evidence[2], f->evidence[3], RS_PACK_FACE_MIN_CONFIDENCE);
     } else if (rep->face_rejected) {
         printf("  face          rejected (its landmarks were not finite): every splat is `other`, framed by the bounds\n");
+    } else if (f->confidence > 0) {
+        printf("  face          not used: confidence %.2f (symmetry %.2f, nose %.2f, eyes %.2f, mouth %.2f) is under %.2f;"
+               " every splat is `other`, framed by the bounds\n",
+               f->confidence, f->evidence[0], f->evidence[1], f->evidence[2], f->evidence[3], RS_PACK_FACE_MIN_CONFIDENCE);
     } else {
         printf("  face          not found: every splat is `other` (see --help for the assumptions)\n");
     }
@@ -518,11 +524,18 @@ static int convert(options *o)
         fprintf(stderr, "rouge-pack: note: %s: scale %.4g mm per unit, %s; set --units if not\n", o->input,
                 cloud->hdr.mm_per_unit, rep.scale_why);
     // Said even with -q (on stderr, once the file is written): the result is not what the face defaults give.
-    if (!rep.face.found)
+    if (!rep.face.found) {
+        char why[128];
+        if (rep.face_rejected)
+            snprintf(why, sizeof why, "a face was found but its frame is not finite, so it is not used");
+        else if (rep.face.confidence > 0)
+            snprintf(why, sizeof why, "no face (the best candidate's confidence is %.2f, under %.2f)", rep.face.confidence,
+                     RS_PACK_FACE_MIN_CONFIDENCE);
+        else
+            snprintf(why, sizeof why, "no face found (in any orientation, nor +y up, +z forward)");
         fprintf(stderr, "rouge-pack: note: %s: %s; converted %s as a plain model, framed by its bounding box\n", o->input,
-                rep.face_rejected ? "a face was found but its frame is not finite, so it is not used"
-                                  : "no face found (in any orientation, nor +y up, +z forward)",
-                whole ? "every component" : "it");
+                why, whole ? "every component" : "it");
+    }
     rs_splat_destroy(cloud);
     return 0;
 }

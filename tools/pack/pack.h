@@ -199,6 +199,8 @@ typedef enum rs_pack_axis {
 // Parses "+x", "-y", "z" (= +z) ...; RS_PACK_AXIS_DEFAULT on anything else.
 rs_pack_axis rs_pack_axis_parse(const char *s);
 
+#define RS_PACK_FACE_MIN_CONFIDENCE 0.6f
+
 typedef struct rs_pack_face {
     bool found;               // false: no face could be read; the whole scan is `other`
     float up[3], forward[3];  // unit, orthogonal
@@ -213,6 +215,10 @@ typedef struct rs_pack_face {
     float face_width;         // silhouette width at the nose tip's height (ears included), model units
     float centre[3];          // centre of the head (orbit centre); the mirror plane goes through it
     bool crown;               // the scan has the top of the head (false: a face-only scan; H from the lips)
+    // How sure the finder is that this is a face, in [0, 1]: the mean of the evidence below. Under
+    // RS_PACK_FACE_MIN_CONFIDENCE the face is not used (found false; the model framed by its bounds).
+    float confidence;
+    float evidence[4];        // each in [0, 1]: mirror symmetry, nose, two eye sockets, mouth line
 } rs_pack_face;
 
 // Finds the face of a head. With both axes RS_PACK_AXIS_DEFAULT the frame comes from the scan itself in

@@ -180,6 +180,57 @@ static void to_model(const rs_pack_face *f, float s, float u, float fw, float ou
     for (int a = 0; a < 3; a++) out[a] = s * f->side[a] + u * f->up[a] + fw * f->forward[a];
 }
 
+static float clamp01(float x)
+{
+    return x < 0 ? 0 : x > 1 ? 1 : x;
+}
+
+// The evidence that the landmarks found lie on a face (each term in [0, 1]); written to f->evidence and
+// f->confidence. Anything with a bump reaches the landmark search (a spider's abdomen, a pig's tail, an
+// engine's bolt), so each term asks what a face has and most other bumps lack:
+//   symmetry: the front surface within +-0.3 H of the nose mirrors about the mid-line (both sides filled,
+//             depths within 2% H): faces 60..95 % of the pairs, parts and animals seen from their end less;
+//   nose:     the tip stands 1.2..4.5% H in front of a ring around it (faces 0.9..3.4 %; a snout, a bolt more);
+//   eyes:     two hollows, one each side 0.07..0.21 H from the mid-line and 0.04..0.24 H above the tip,
+//             mirrored (within 5% H), 4..35% H below the ring around them (faces 10..36 %, gaps between parts
+//             deeper);
+//   mouth:    a horizontal crease on the mid-line where the mouth was put, shallow (faces 0.04..0.2% H).
+// The ranges were read off the Lee Perry-Smith and Demosthenes scans and assimp's test models.
+static void face_evidence(const hmap *m, rs_pack_face *f, float nose_s, float nose_u, float H, float nose_p,
+                          float mouth_u)
+{
+    int agree = 0, seen = 0;
+    for (int j = -12; j <= 12; j++)
+        for (int i = 1; i <= 12; i++) {
+            float u = nose_u + 0.025f * H * j, ds = 0.025f * H * i;
+            float a = hm_at(m, nose_s - ds, u), b = hm_at(m, nose_s + ds, u);
+            if (a == -INFINITY && b == -INFINITY) continue;
+            seen++;
+            agree += a != -INFINITY && b != -INFINITY && fabsf(a - b) < 0.02f * H;
+        }
+    float sym = seen ? (float)agree / seen : 0;
+    f->evidence[0] = clamp01((sym - 0.4f) / 0.4f);
+    float p = nose_p / H;
+    f->evidence[1] = fminf(clamp01((p - 0.005f) / 0.007f), clamp01((0.08f - p) / 0.035f));
+    float eye_d[2] = {0, 0}, eye_s[2] = {0, 0}, eye_u[2] = {0, 0};
+    for (int side = 0; side < 2; side++) {
+        float dir = side ? 1.0f : -1.0f;
+        for (int j = 0; j <= 10; j++)
+            for (int i = 0; i <= 7; i++) {
+                float s = nose_s + dir * (0.07f + 0.02f * i) * H, u = nose_u + (0.04f + 0.02f * j) * H;
+                float d = -protrusion(m, s, u, 0.06f * H);
+                if (d != INFINITY && d > eye_d[side]) eye_d[side] = d, eye_s[side] = s, eye_u[side] = u;
+            }
+    }
+    bool mirrored = fabsf(eye_s[0] + eye_s[1] - 2 * nose_s) < 0.05f * H && fabsf(eye_u[0] - eye_u[1]) < 0.05f * H;
+    // Deeper than half a face height is a hole or a gap between parts, not an eye socket.
+    float e_lo = fminf(eye_d[0], eye_d[1]) / H, e_hi = fmaxf(eye_d[0], eye_d[1]) / H;
+    f->evidence[2] = fminf(clamp01((e_lo - 0.01f) / 0.03f), clamp01((0.5f - e_hi) / 0.15f)) * (mirrored ? 1.0f : 0.25f);
+    float c = crease(m, nose_s, mouth_u, 0.012f * H) / H;
+    f->evidence[3] = c == -INFINITY ? 0 : fminf(clamp01(c / 0.0004f), clamp01((0.04f - c) / 0.02f));
+    f->confidence = 0.25f * (f->evidence[0] + f->evidence[1] + f->evidence[2] + f->evidence[3]);
+}
+
 // Everything past the frame: returns false when no face can be read (then the caller keeps defaults).
 // H_fixed > 0 sets the face height instead of measuring it from the top of the scan (a face-only scan).
 static bool find_landmarks(const float (*pos)[3], const float (*normal)[3], uint32_t count, rs_pack_face *f, hmap *m,
@@ -404,7 +455,50 @@ static bool find_landmarks(const float (*pos)[3], const float (*normal)[3], uint
     }
     if (back == INFINITY) back = front = nose_f;
     to_model(f, nose_s, cu, 0.5f * (front + back), f->centre);
+    face_evidence(m, f, nose_s, nose_u, H, best_p, mouth_u);
     return true;
+}
+
+// The centre and size of a model without a face: its bounding box's centre and diagonal (the camera's
+// zoom 1 fits the whole model from any side).
+static void bounds_frame(const float (*pos)[3], uint32_t count, rs_pack_face *f)
+{
+    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < count; i++)
+        for (int a = 0; a < 3; a++) mn[a] = fminf(mn[a], pos[i][a]), mx[a] = fmaxf(mx[a], pos[i][a]);
+    for (int a = 0; a < 3; a++) f->centre[a] = 0.5f * (mn[a] + mx[a]);
+    f->face_height = (float)hypot(hypot((double)mx[0] - mn[0], (double)mx[1] - mn[1]), (double)mx[2] - mn[2]);
+    if (!(f->face_height > 0) || !isfinite(f->face_height)) f->face_height = 1.0f;
+}
+
+// The frame of a model without a face and without axes given: +y up and +z forward (the convention of
+// glTF, OBJ and most exporters), except that a flat model (one bounding-box side under a third of the
+// next) is seen face-on, along its thin axis, and a model whose z side is over 3x the others while y is
+// the shortest (a standing figure from a z-up exporter; a y-up car, 2.5x, is not one) stands on z.
+static void plain_axes(const float (*pos)[3], uint32_t count, rs_pack_face *f)
+{
+    float mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (uint32_t i = 0; i < count; i++)
+        for (int a = 0; a < 3; a++) mn[a] = fminf(mn[a], pos[i][a]), mx[a] = fmaxf(mx[a], pos[i][a]);
+    float e[3];
+    for (int a = 0; a < 3; a++) e[a] = mx[a] - mn[a];
+    if (!isfinite(e[0] + e[1] + e[2])) return;
+    int thin = 0;
+    for (int a = 1; a < 3; a++)
+        if (e[a] < e[thin]) thin = a;
+    float mid = fminf(e[(thin + 1) % 3], e[(thin + 2) % 3]);
+    float up[3] = {0, 1, 0}, fw[3] = {0, 0, 1};
+    if (e[thin] < mid / 3) {
+        if (thin == 0) fw[2] = 0, fw[0] = 1;                      // a wall in yz: from +x
+        else if (thin == 1) up[1] = 0, up[2] = -1, fw[2] = 0, fw[1] = 1;  // lying in xz: from above, +z down
+    } else if (e[2] > 3.0f * fmaxf(e[0], e[1]) && e[1] <= e[0]) {
+        up[1] = 0, up[2] = 1, fw[2] = 0, fw[1] = -1;  // z up, looking along -y (Blender's front view)
+    }
+    memcpy(f->up, up, sizeof up);
+    memcpy(f->forward, fw, sizeof fw);
+    f->side[0] = up[1] * fw[2] - up[2] * fw[1];
+    f->side[1] = up[2] * fw[0] - up[0] * fw[2];
+    f->side[2] = up[0] * fw[1] - up[1] * fw[0];
 }
 
 rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uint32_t count,
@@ -414,7 +508,9 @@ rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uin
     axis_vector(up, RS_PACK_AXIS_POS_Y, u);
     axis_vector(forward, RS_PACK_AXIS_POS_Z, fw);
     if (fabsf(dot3(u, fw)) > 0.5f) return rs_fail(err, RS_ERR_ARG, "--up and --forward must be different axes");
-    if (up == RS_PACK_AXIS_DEFAULT && forward == RS_PACK_AXIS_DEFAULT) {
+    bool guess = up == RS_PACK_AXIS_DEFAULT && forward == RS_PACK_AXIS_DEFAULT;
+    float best = 0, best_ev[4] = {0, 0, 0, 0};
+    if (guess) {
         // No axes given: the frame comes from the scan itself, whatever its orientation (pack_frame.c);
         // when no face can be read that way, the default axes frame the model.
         bool found;
@@ -424,16 +520,35 @@ rs_result rs_pack_find_face(const float (*pos)[3], const float (*normal)[3], uin
         if (found) {
             r = rs_pack_find_face_frame(pos, normal, count, ou, of, out, err);
             if (r != RS_OK) return r;
-            if (out->found) {
+            if (out->found && out->confidence >= RS_PACK_FACE_MIN_CONFIDENCE) {
                 // The orbit centre on the mirror plane, which the whole scan fixes better than the one
                 // nose-tip point the finder puts it through.
                 float off = dot3(out->centre, out->side) - mid;
                 for (int a = 0; a < 3; a++) out->centre[a] -= off * out->side[a];
                 return RS_OK;
             }
+            if (out->found && isfinite(out->confidence)) best = out->confidence, memcpy(best_ev, out->evidence, sizeof best_ev);
         }
     }
-    return rs_pack_find_face_frame(pos, normal, count, u, fw, out, err);
+    rs_result r = rs_pack_find_face_frame(pos, normal, count, u, fw, out, err);
+    if (r != RS_OK) return r;
+    if (out->found && out->confidence >= RS_PACK_FACE_MIN_CONFIDENCE) return RS_OK;
+    if (out->found && isfinite(out->confidence) && out->confidence > best)
+        best = out->confidence, memcpy(best_ev, out->evidence, sizeof best_ev);
+    // Too little of a face: the plain frame (the bounds; without axes given, plain_axes's); the best
+    // candidate's evidence stays for the report.
+    if (guess) {
+        rs_pack_face axes = {0};
+        plain_axes(pos, count, &axes);
+        memcpy(u, axes.up, sizeof u);
+        memcpy(fw, axes.forward, sizeof fw);
+    }
+    r = rs_pack_find_face_frame(pos, normal, 0, u, fw, out, err);
+    if (r != RS_OK) return r;
+    bounds_frame(pos, count, out);
+    out->confidence = best;
+    memcpy(out->evidence, best_ev, sizeof best_ev);
+    return RS_OK;
 }
 
 rs_result rs_pack_find_face_frame(const float (*pos)[3], const float (*normal)[3], uint32_t count, const float up[3],
