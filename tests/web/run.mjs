@@ -236,9 +236,10 @@ if (main?.state === 'ready') {
         check('the page shows what rouge render shows', db >= 32, `PSNR ${db.toFixed(1)} dB >= 32 against the native render`);
     });
 
-    let lips = null;
+    let lips = null, lipsView = null;  // the lips' pixels and the view they were found in
     await run('a one-finger lipstick stroke paints the lips and nothing else', async () => {
         lips = await lipsMask(page);
+        lipsView = await page.evaluate(() => { const v = window.rouge.getView(); return { yaw: v.yaw, pitch: v.pitch, zoom: v.zoom, pan: v.pan }; });
         if (!lips) throw new Error('no lips pixel found by picking');
         const { mask, width: w } = lips;
         // The lips' widest row: the stroke runs along it, beyond both corners of the mouth.
@@ -379,21 +380,22 @@ if (main?.state === 'ready') {
     });
 
     await run('the smudge tool drags the lipstick off the lips', async () => {
-        if (!lips) {  // run alone (WEB_ONLY): the lipstick first, along the lips' widest row
-            lips = await lipsMask(page);
-            if (!lips) throw new Error('no lips pixel found by picking');
-            let best = -1, bestN = 0;
-            for (let y = 0; y < lips.height; y++) {
-                let k = 0;
-                for (let x = 0; x < lips.width; x++) k += lips.mask[y * lips.width + x];
-                if (k > bestN) bestN = k, best = y;
-            }
-            let x0 = lips.width, x1 = 0;
-            for (let x = 0; x < lips.width; x++) if (lips.mask[best * lips.width + x]) x0 = Math.min(x0, x), x1 = Math.max(x1, x);
-            await page.evaluate(() => window.rouge.setBrush({ cosmetic: 'lipstick_satin' }));
-            await touchStroke(cdp, line(x0, best, x1, best, 16));
-            await settle(page);
+        // The gesture tests in between turned and zoomed the head and cleared the face: back to the view the
+        // lips were found in (or find them, run alone), and a lipstick along the lips' widest row.
+        if (lipsView) await page.evaluate((v) => window.rouge.setView(v), lipsView), await settle(page);
+        else lips = await lipsMask(page);
+        if (!lips) throw new Error('no lips pixel found by picking');
+        let best = -1, bestN = 0;
+        for (let y = 0; y < lips.height; y++) {
+            let k = 0;
+            for (let x = 0; x < lips.width; x++) k += lips.mask[y * lips.width + x];
+            if (k > bestN) bestN = k, best = y;
         }
+        let x0 = lips.width, x1 = 0;
+        for (let x = 0; x < lips.width; x++) if (lips.mask[best * lips.width + x]) x0 = Math.min(x0, x), x1 = Math.max(x1, x);
+        await page.evaluate(() => window.rouge.setBrush({ cosmetic: 'lipstick_satin' }));
+        await touchStroke(cdp, line(x0, best, x1, best, 16));
+        await settle(page);
         const bad = await page.evaluate(() => window.rouge.setBrush({ tool: 'rub' }).then(() => 'accepted', (e) => e.message));
         await page.evaluate(() => window.rouge.setBrush({ tool: 'smudge', size: 0.05 }));
         const { mask, width: w, height: h } = lips;
