@@ -36,6 +36,20 @@ static bool frame(rouge_mode mode, rouge_pipeline pipeline, uint8_t *rgba)
     return RS_CHECK(rouge_face_read_rgba(face, rgba, (size_t)SIZE * SIZE * 4, &e) == ROUGE_OK, "read: %s", e.msg);
 }
 
+// The normals and regions views of the close-up, drawn once per pipeline and shared by the crease and rim
+// checks (the same view: each frame costs a full render).
+static uint8_t *shared[2][2];
+
+static bool shared_frame(rouge_mode mode, rouge_pipeline pipeline, uint8_t *rgba)
+{
+    size_t n = (size_t)SIZE * SIZE * 4;
+    uint8_t **slot = &shared[pipeline == ROUGE_PIPELINE_MOBILE][mode == ROUGE_MODE_REGIONS];
+    if (*slot) return memcpy(rgba, *slot, n), true;
+    if (!frame(mode, pipeline, rgba)) return false;
+    if ((*slot = malloc(n))) memcpy(*slot, rgba, n);
+    return true;
+}
+
 // The region of a regions-view pixel: nearest palette colour (src/render/render_attribute.c), -1 if none.
 static int region_of(const uint8_t *p)
 {
@@ -72,8 +86,8 @@ static void check_pipeline(rouge_pipeline pipeline, const char *name)
     uint8_t *albedo = malloc(n), *normals = malloc(n), *regions = malloc(n), *full = malloc(n),
             *diffuse = malloc(n), *band = calloc((size_t)SIZE * SIZE, 1);
     if (!RS_CHECK(albedo && normals && regions && full && diffuse && band, "out of memory")) goto out;
-    if (!frame(ROUGE_MODE_ALBEDO, pipeline, albedo) || !frame(ROUGE_MODE_NORMALS, pipeline, normals) ||
-        !frame(ROUGE_MODE_REGIONS, pipeline, regions) || !frame(ROUGE_MODE_FULL, pipeline, full) ||
+    if (!frame(ROUGE_MODE_ALBEDO, pipeline, albedo) || !shared_frame(ROUGE_MODE_NORMALS, pipeline, normals) ||
+        !shared_frame(ROUGE_MODE_REGIONS, pipeline, regions) || !frame(ROUGE_MODE_FULL, pipeline, full) ||
         !frame(ROUGE_MODE_DIFFUSE, pipeline, diffuse))
         goto out;
     int count = 0;
@@ -106,8 +120,8 @@ static void check_rim(rouge_pipeline pipeline, const char *name)
     int *under = calloc((size_t)SIZE * SIZE, sizeof *under), *side = calloc((size_t)SIZE * SIZE, sizeof *side),
         *facing = calloc((size_t)SIZE * SIZE, sizeof *facing);
     if (!RS_CHECK(spec && normals && regions && under && side && facing, "out of memory")) goto out;
-    if (!frame(ROUGE_MODE_SPECULAR, pipeline, spec) || !frame(ROUGE_MODE_NORMALS, pipeline, normals) ||
-        !frame(ROUGE_MODE_REGIONS, pipeline, regions))
+    if (!frame(ROUGE_MODE_SPECULAR, pipeline, spec) || !shared_frame(ROUGE_MODE_NORMALS, pipeline, normals) ||
+        !shared_frame(ROUGE_MODE_REGIONS, pipeline, regions))
         goto out;
     int nu = 0, ns = 0, nf = 0, under_max = 0;
     for (int i = 0; i < SIZE * SIZE; i++) {
@@ -212,6 +226,7 @@ int main(int argc, char **argv)
         RS_RUN(test_no_bright_rim_under_the_nose_reference);
         RS_RUN(test_no_bright_rim_under_the_nose_mobile);
     }
+    for (int k = 0; k < 4; k++) free(shared[k / 2][k % 2]);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
     return rs_test_finish();

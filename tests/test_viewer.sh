@@ -236,59 +236,125 @@ if selected viewer_bad_event_script_names_the_line; then
     else echo "ok - $name"; fi
 fi
 
-if selected viewer_bad_dropped_file_keeps_the_face; then
-    name=viewer_bad_dropped_file_keeps_the_face
+# Four independent interactions share one launch (a launch costs ~5 CPU-s): a bad drop, the light and
+# camera reset, the Shift+digit zooms and the eyedropper, in that order. Each starts from the picture as
+# it started: the drop must leave the face as it was, and 0 brings camera and light back (both checked).
+drop_sel=0 reset_sel=0 zoom_sel=0 eye_sel=0
+selected viewer_bad_dropped_file_keeps_the_face && drop_sel=1
+selected viewer_key_0_resets_camera_and_light && reset_sel=1
+selected viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek && zoom_sel=1
+selected viewer_eyedropper_takes_the_face_colour_into_the_editor && eye_sel=1
+if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
+    rm -f "$out"/z[0-4].txt "$out"/eye[01].txt
     head -c 1000 "$face" >"$out/dropped.rsf"
     # A FIFO dropped too: opening it once blocked the loader, and then the viewer could not be quit.
     rm -f "$out/dropped.fifo" && mkfifo "$out/dropped.fifo"
     {
         echo "key i"
-        echo "move 400 580"
-        echo "idle"
-        echo "screenshot $out/dbefore_face.png 80 80 630 180"
-        echo "drop $out/dropped.rsf"
-        echo "wait 1.5"
-        echo "drop $out/dropped.fifo"
-        echo "wait 1.5"
-        echo "idle"
-        echo "screenshot $out/dafter_face.png 80 80 630 180"
-        echo "screenshot $out/dafter_all.png"
+        if [ $drop_sel = 1 ]; then
+            echo "move 400 580"
+            echo "idle"
+            echo "screenshot $out/dbefore_face.png 80 80 630 180"
+            echo "drop $out/dropped.rsf"
+            echo "wait 1.5"
+            echo "drop $out/dropped.fifo"
+            echo "wait 1.5"
+            echo "idle"
+            echo "screenshot $out/dafter_face.png 80 80 630 180"
+            echo "screenshot $out/dafter_all.png"
+        fi
+        if [ $reset_sel = 1 ]; then
+            # The sun dial sits at (698, 86) 84x84 on an 800x600 window (rs_ui_toolbar_layout_compute,
+            # scale 1): a drag on it moves the light (geared: 50 px drag = 0.42 of the dial), arrows orbit;
+            # `0` must bring back the picture as it started.
+            echo "move 400 580"
+            echo "idle"
+            echo "screenshot $out/r0before_face.png 80 80 630 330"
+            echo "drag 740 128 690 100 10"
+            echo "key left"
+            echo "move 400 580"
+            echo "idle"
+            echo "screenshot $out/r0moved_face.png 80 80 630 330"
+            echo "key 0"
+            echo "idle"
+            echo "screenshot $out/r0after_face.png 80 80 630 330"
+        fi
+        if [ $zoom_sel = 1 ]; then
+            # Issue 21: one key brings the lips (Shift+2), the eyes (Shift+1) or a cheek (Shift+3) to fill
+            # the view; 0 goes back. The lips sit below the face's centre (the picture moves up: pan y < 0),
+            # the eyes well above them.
+            echo "move 400 580"
+            echo "idle"
+            echo "state $out/z0.txt"
+            echo "key shift+2"
+            echo "idle"
+            echo "state $out/z1.txt"
+            echo "screenshot $out/z1_lips.png 80 80 630 330"
+            echo "key shift+1"
+            echo "idle"
+            echo "state $out/z2.txt"
+            echo "key shift+3"
+            echo "idle"
+            echo "state $out/z3.txt"
+            echo "key 0"
+            echo "idle"
+            echo "state $out/z4.txt"
+        fi
+        if [ $eye_sel = 1 ]; then
+            # Issue 21: V in the product editor takes the colour under the pointer from the rendered face:
+            # over the lips (zoomed to with Shift+2) the product turns lip red, whatever the preset was.
+            echo "key shift+2"
+            echo "key c"
+            echo "move 300 320"
+            echo "idle"
+            echo "state $out/eye0.txt"
+            echo "key v"
+            echo "idle"
+            echo "state $out/eye1.txt"
+        fi
         echo "quit"
-    } >"$out/drop.events"
-    view --events "$out/drop.events" >"$out/drop.log" 2>&1
+    } >"$out/views.events"
+    view --events "$out/views.events" >"$out/views.log" 2>&1
     rc=$?
-    if [ $rc -ne 0 ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/drop.log")"
+fi
+if [ $drop_sel = 1 ]; then
+    name=viewer_bad_dropped_file_keeps_the_face
+    if [ $rc -ne 0 ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/views.log")"
     elif [ ! -f "$out/dafter_face.png" ]; then echo "FAIL - $name: no screenshot"
     elif why=$(region_same dbefore dafter face); then echo "ok - $name"
     else echo "FAIL - $name: the face changed after a bad drop: $why"; fi
 fi
-if selected viewer_key_0_resets_camera_and_light; then
-    # The sun dial sits at (698, 86) 84x84 on an 800x600 window (rs_ui_toolbar_layout_compute, scale 1):
-    # a drag on it moves the light (geared: 50 px drag = 0.42 of the dial), arrows orbit; `0` must bring
-    # back the picture as it started.
+if [ $reset_sel = 1 ]; then
     name=viewer_key_0_resets_camera_and_light
-    {
-        echo "key i"
-        echo "move 400 580"
-        echo "idle"
-        echo "screenshot $out/r0before_face.png 80 80 630 330"
-        echo "drag 740 128 690 100 10"
-        echo "key left"
-        echo "move 400 580"
-        echo "idle"
-        echo "screenshot $out/r0moved_face.png 80 80 630 330"
-        echo "key 0"
-        echo "idle"
-        echo "screenshot $out/r0after_face.png 80 80 630 330"
-        echo "quit"
-    } >"$out/reset.events"
-    view --events "$out/reset.events" >"$out/reset.log" 2>&1
-    rc=$?
-    if [ $rc -ne 0 ] || [ ! -f "$out/r0after_face.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/reset.log")"
+    if [ $rc -ne 0 ] || [ ! -f "$out/r0after_face.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/views.log")"
     elif "$imgdiff" "$out/r0before_face.png" "$out/r0moved_face.png" --threshold 8 | awk '/^frac_over/ {exit !($2 < 0.05)}'; then
         echo "FAIL - $name: the dial tap and the orbit did not change the picture"
     elif why=$(region_same r0before r0after face); then echo "ok - $name"
     else echo "FAIL - $name: after 0 the picture differs from the start: $why"; fi
+fi
+if [ $zoom_sel = 1 ]; then
+    name=viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek
+    zv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/z$1.txt" 2>/dev/null; }
+    if [ $rc -ne 0 ] || [ ! -f "$out/z4.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/views.log")"
+    elif ! echo "$(zv 1 zoom) $(zv 1 pan)" | awk '{ exit !($1 >= 2 && $3 < -0.1) }'; then
+        echo "FAIL - $name: Shift+2 did not zoom to the lips (zoom, pan: $(zv 1 zoom) $(zv 1 pan))"
+    elif ! echo "$(zv 2 zoom) $(zv 2 pan) $(zv 1 pan)" | awk '{ exit !($1 >= 2 && $3 > $5 + 0.5) }'; then
+        echo "FAIL - $name: Shift+1 did not zoom to the eyes (zoom, pan: $(zv 2 zoom) $(zv 2 pan))"
+    elif ! echo "$(zv 3 zoom) $(zv 3 pan)" | awk '{ exit !($1 >= 2 && ($2 > 0.1 || $2 < -0.1)) }'; then
+        echo "FAIL - $name: Shift+3 did not zoom to a cheek (zoom, pan: $(zv 3 zoom) $(zv 3 pan))"
+    elif [ "$(zv 4 zoom) $(zv 4 pan)" != "$(zv 0 zoom) $(zv 0 pan)" ]; then
+        echo "FAIL - $name: 0 did not bring the view back ($(zv 0 zoom) $(zv 0 pan) -> $(zv 4 zoom) $(zv 4 pan))"
+    else echo "ok - $name"; fi
+fi
+if [ $eye_sel = 1 ]; then
+    name=viewer_eyedropper_takes_the_face_colour_into_the_editor
+    rgb0=$(awk '$1 == "editor_rgb" {print $2, $3, $4}' "$out/eye0.txt" 2>/dev/null)
+    rgb1=$(awk '$1 == "editor_rgb" {print $2, $3, $4}' "$out/eye1.txt" 2>/dev/null)
+    if [ $rc -ne 0 ] || [ -z "$rgb1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/views.log")"
+    elif [ "$rgb0" = "$rgb1" ]; then echo "FAIL - $name: V left the editor's colour at $rgb0"
+    elif ! echo "$rgb1" | awk '{ exit !($1 - $2 >= 40 && $1 - $3 >= 30) }'; then
+        echo "FAIL - $name: the colour taken from the lips, $rgb1, is not lip red"
+    else echo "ok - $name"; fi
 fi
 if selected viewer_s_saves_at_full_quality; then
     # S pressed right after an orbit (the picture still coarse) must save the same picture as S pressed once
@@ -641,69 +707,6 @@ if selected viewer_product_editor_keeps_the_face_at_full_quality; then
     if [ $rc -ne 0 ] || [ -z "$r1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/edq.log")"
     elif [ "$r0" = "$r1" ] || [ $((f - f0)) -lt 3 ]; then echo "FAIL - $name: the drag did not act over several frames ($r0 -> $r1, $((f - f0)) frames)"
     elif [ "$range" != "1.000 1.000" ]; then echo "FAIL - $name: the face was drawn at render scales $range while the colour moved"
-    else echo "ok - $name"; fi
-fi
-if selected viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek; then
-    # Issue 21: one key brings the lips (Shift+2), the eyes (Shift+1) or a cheek (Shift+3) to fill the view;
-    # 0 goes back. The lips sit below the face's centre (the picture moves up: pan y < 0), the eyes well
-    # above them.
-    name=viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek
-    {
-        echo "move 400 580"
-        echo "idle"
-        echo "state $out/z0.txt"
-        echo "key shift+2"
-        echo "idle"
-        echo "state $out/z1.txt"
-        echo "screenshot $out/z1_lips.png 80 80 630 330"
-        echo "key shift+1"
-        echo "idle"
-        echo "state $out/z2.txt"
-        echo "key shift+3"
-        echo "idle"
-        echo "state $out/z3.txt"
-        echo "key 0"
-        echo "idle"
-        echo "state $out/z4.txt"
-        echo "quit"
-    } >"$out/zoom.events"
-    view --events "$out/zoom.events" >"$out/zoom.log" 2>&1
-    rc=$?
-    zv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/z$1.txt" 2>/dev/null; }
-    if [ $rc -ne 0 ] || [ ! -f "$out/z4.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/zoom.log")"
-    elif ! echo "$(zv 1 zoom) $(zv 1 pan)" | awk '{ exit !($1 >= 2 && $3 < -0.1) }'; then
-        echo "FAIL - $name: Shift+2 did not zoom to the lips (zoom, pan: $(zv 1 zoom) $(zv 1 pan))"
-    elif ! echo "$(zv 2 zoom) $(zv 2 pan) $(zv 1 pan)" | awk '{ exit !($1 >= 2 && $3 > $5 + 0.5) }'; then
-        echo "FAIL - $name: Shift+1 did not zoom to the eyes (zoom, pan: $(zv 2 zoom) $(zv 2 pan))"
-    elif ! echo "$(zv 3 zoom) $(zv 3 pan)" | awk '{ exit !($1 >= 2 && ($2 > 0.1 || $2 < -0.1)) }'; then
-        echo "FAIL - $name: Shift+3 did not zoom to a cheek (zoom, pan: $(zv 3 zoom) $(zv 3 pan))"
-    elif [ "$(zv 4 zoom) $(zv 4 pan)" != "$(zv 0 zoom) $(zv 0 pan)" ]; then
-        echo "FAIL - $name: 0 did not bring the view back ($(zv 0 zoom) $(zv 0 pan) -> $(zv 4 zoom) $(zv 4 pan))"
-    else echo "ok - $name"; fi
-fi
-if selected viewer_eyedropper_takes_the_face_colour_into_the_editor; then
-    # Issue 21: V in the product editor takes the colour under the pointer from the rendered face: over
-    # the lips (zoomed to with Shift+2) the product turns lip red, whatever the preset was.
-    name=viewer_eyedropper_takes_the_face_colour_into_the_editor
-    {
-        echo "key shift+2"
-        echo "key c"
-        echo "move 300 320"
-        echo "idle"
-        echo "state $out/eye0.txt"
-        echo "key v"
-        echo "idle"
-        echo "state $out/eye1.txt"
-        echo "quit"
-    } >"$out/eyedrop.events"
-    view --events "$out/eyedrop.events" >"$out/eyedrop.log" 2>&1
-    rc=$?
-    rgb0=$(awk '$1 == "editor_rgb" {print $2, $3, $4}' "$out/eye0.txt" 2>/dev/null)
-    rgb1=$(awk '$1 == "editor_rgb" {print $2, $3, $4}' "$out/eye1.txt" 2>/dev/null)
-    if [ $rc -ne 0 ] || [ -z "$rgb1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/eyedrop.log")"
-    elif [ "$rgb0" = "$rgb1" ]; then echo "FAIL - $name: V left the editor's colour at $rgb0"
-    elif ! echo "$rgb1" | awk '{ exit !($1 - $2 >= 40 && $1 - $3 >= 30) }'; then
-        echo "FAIL - $name: the colour taken from the lips, $rgb1, is not lip red"
     else echo "ok - $name"; fi
 fi
 if selected viewer_my_shades_persist_and_can_be_picked_again; then

@@ -211,18 +211,26 @@ rs_result rs_look_apply(const rs_look *look, rs_makeup *mk, rs_makeup_range *dir
     return RS_OK;
 }
 
-rs_result rs_look_load(rs_makeup *mk, const char *path, rs_makeup_range *dirty, rs_error *err)
+rs_result rs_look_read(const char *path, rs_look **out, rs_error *err)
 {
-    if (dirty) *dirty = (rs_makeup_range){0, 0};
+    *out = NULL;
     void *data = NULL;
     size_t len = 0;
     rs_result r = rs_file_read_all(path, RS_LOOK_MAX_BYTES, &data, &len, err);
     if (r != RS_OK) return r;
-    rs_look *look = NULL;
     rs_error inner = {0};
-    r = rs_look_parse(data, len, &look, &inner);
+    r = rs_look_parse(data, len, out, &inner);
     free(data);
-    if (r != RS_OK) return rs_fail(err, r, "%s: %s", path, inner.msg);
+    return r != RS_OK ? rs_fail(err, r, "%s: %s", path, inner.msg) : RS_OK;
+}
+
+rs_result rs_look_load(rs_makeup *mk, const char *path, rs_makeup_range *dirty, rs_error *err)
+{
+    if (dirty) *dirty = (rs_makeup_range){0, 0};
+    rs_look *look = NULL;
+    rs_result r = rs_look_read(path, &look, err);
+    if (r != RS_OK) return r;
+    rs_error inner = {0};
     r = rs_look_apply(look, mk, dirty, &inner);
     rs_look_destroy(look);
     if (r != RS_OK) return rs_fail(err, r, "%s: %s", path, inner.msg);

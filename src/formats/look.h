@@ -45,6 +45,9 @@ void rs_look_destroy(rs_look *look);
 // Replaces the layer's makeup by the look (reset, replay stroke by stroke, fresh undo history). Fails
 // with RS_ERR_ARG when the look was made on a face of another height (more than 10 % off).
 rs_result rs_look_apply(const rs_look *look, rs_makeup *mk, rs_makeup_range *dirty, rs_error *err);
+// Reads and parses a look file without applying it (a host checks its input before making a context).
+// Errors: "PATH: line N: field: why".
+rs_result rs_look_read(const char *path, rs_look **out, rs_error *err);
 rs_result rs_look_load(rs_makeup *mk, const char *path, rs_makeup_range *dirty, rs_error *err);
 
 rs_result rs_look_write_memory(const rs_makeup *mk, char **out, size_t *out_len, rs_error *err);
