@@ -113,14 +113,18 @@ void rs_fine_apply(vec3 pm, vec3 nm, inout vec3 albedo, inout float m, inout flo
             stroke = t2.y, best = 0.0, reached = false;
         }
         float vl = length(t1.xyz);
-        if (vl > 0.0 && dot(nm, t1.xyz) <= 0.2 * vl) continue;  // RS_MAKEUP_FACING_MIN
+        int reg = int(t2.w);
+        // RS_MAKEUP_FACING_MIN; a product kept to a region only needs the surface to face the view at all:
+        // its mask, not the grazing angle, bounds it (the lips roll into the mouth line at a grazing angle).
+        if (vl > 0.0 && dot(nm, t1.xyz) <= (reg != 0 ? 0.0 : 0.2) * vl) continue;
         product = int(t2.x), eraser = t2.z > 0.5;
         vec4 pr = rs_fine_texel(u_fine_products + 3 * product + 2);
         float ig = rs_fine_falloff(length(pm - t0.xyz) / t0.w, eraser ? 0.0 : pr.w);
-        int reg = int(t2.w);
         if (reg != 0 && ig > 0.0) {
             if (reg != region) region = reg, region_w = rs_fine_region_weight(reg, pm);
-            ig *= region_w;
+            // Kept to a region, the stroke fills it up to the mask within the brush's reach, as a lipstick
+            // is applied: the mask draws the border, the stroke only has to pass near it.
+            ig = min(1.0, 4.0 * ig) * region_w;
         }
         if (ig <= 0.0) continue;
         if (!reached && !eraser) touches += 1.0;

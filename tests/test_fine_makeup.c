@@ -345,6 +345,13 @@ static uint8_t *lips_truth(const uint8_t *bare, int w, int h, int *mouth_y)
         double dark = 1e9;
         for (int y = top + (bottom - top) / 4; y <= bottom - (bottom - top) / 4; y++)
             if (lum(bare + ((size_t)y * w + x) * 4) < dark) dark = lum(bare + ((size_t)y * w + x) * 4), mouth_y[x] = y;
+        // Each lip is the lip colour joined to the mouth line (gaps up to 3 px: the mouth line's own dark
+        // pixels): red skin cut off from the lips above them, like the philtrum's flush under the nose, is skin.
+        top = bottom = mouth_y[x];
+        for (int y = mouth_y[x], gap = 0; y >= 0 && gap <= 3; y--)
+            if (region[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) top = y, gap = 0; else gap++;
+        for (int y = mouth_y[x], gap = 0; y < h && gap <= 3; y++)
+            if (region[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) bottom = y, gap = 0; else gap++;
         tops[x] = top, bottoms[x] = bottom;
     }
     // The vermilion border is a smooth curve; the colour's texture is not: the outer borders are the
@@ -492,16 +499,20 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
            100 * sp, wt, wb);
     // Issue 21's goal (>= 95 % of each lip, <= 0.5 % spill, edges within 1 px of their smoothed lines) is
     // not met yet. The lipstick is drawn per pixel, masked by the lips' field (makeup.c, "Region masks per
-    // pixel"): its edges are the field's smooth level line, no longer the splats' staircase, but that line
-    // is not yet the border this test reads from the picture (the cupid's bow, the lower lip's soft bottom
-    // edge) and the dark mouth line falls below the lip colour's cut. Until it is, today's numbers
-    // (85.4 / 94.9 %, spill 3.1 %, wander 0.81 / 1.66 px; per splat they were 91.0 / 95.9 %, 6.0 %,
-    // 2.1 / 3.1 px) are guarded against regressions.
+    // pixel") and fills it within the brush's reach (makeup_fine.glsl): the upper lip now takes the paint
+    // down to the mouth line. The field's 0.5 line is not yet the border this test reads from the picture:
+    // it runs outside it at the lower lip's left side and the upper lip's corners (the spill) and inside it
+    // at the lower lip's right end (the rendered a* carries the key light's side, the field the albedo's);
+    // the cupid's bow is flatter. Until it is, today's numbers (94.4 / 96.6 %, spill 5.6 %, wander
+    // 0.78 / 1.70 px; with the stroke's falloff as the fill and the 0.2 facing test they were 86.8 / 95.5 %,
+    // 4.2 %, 0.81 / 1.66 px, measured against the truth that still held the philtrum) are guarded against
+    // regressions. Raising the field's cut (makeup.c, 0.5) trades spill for cover: at 0.55 92.4 / 91.2 %,
+    // 2.7 %; at 0.6 85.6 / 83.1 %, 0.45 %.
     bool goal = cu >= 0.95 && cl >= 0.95 && sp <= 0.005 && wt <= 1.0 && wb <= 1.0;
-    bool held = cu >= 0.84 && cl >= 0.93 && sp <= 0.037 && wt <= 1.1 && wb <= 2.0;
+    bool held = cu >= 0.935 && cl >= 0.955 && sp <= 0.058 && wt <= 0.85 && wb <= 1.8;
     RS_CHECK(goal || held,
-             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 85.4 / 94.9), spill %.2f %% (was 3.1), "
-             "edges wander %.2f / %.2f px (were 0.81 / 1.66)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
+             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 94.4 / 96.6), spill %.2f %% (was 5.64), "
+             "edges wander %.2f / %.2f px (were 0.78 / 1.70)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
     free(top), free(bottom), free(d), free(full), free(mid[1]), free(mid[2]), free(lip), free(mouth);
     free(bare), free(paint);
     rouge_face_clear(face, &e);
