@@ -939,6 +939,24 @@ static float field_weight(const rs_makeup_field *f, float x, float y, float z)
     return RS_CLAMP((q - f->threshold) / f->band + 0.5f, 0.0f, 1.0f);
 }
 
+// rs_makeup_field_weight (the smudge's CPU copy of the shader's mask) on a 2x1x1 field, 0 | 255, cut 0.5
+// band 0.2: voxel centres give 0 and 1, the midpoint the cut (0.5), outside the box the edge voxel's value,
+// 60 % of the way 0.6 -> ramped (0.6 - 0.5) / 0.2 + 0.5 = 1; no field: 1 everywhere.
+static void test_field_weight_interpolates_and_ramps_like_the_shader(void)
+{
+    uint8_t v[2] = {0, 255};
+    rs_makeup_field f = {.origin = {0, 0, 0}, .voxel = 1.0f, .dim = {2, 1, 1}, .value = v, .threshold = 0.5f, .band = 0.2f};
+    const float at[5][3] = {{0.5f, 0.5f, 0.5f}, {1.5f, 0.5f, 0.5f}, {1.0f, 0.5f, 0.5f}, {-3.0f, 0.5f, 0.5f}, {1.1f, 0.5f, 0.5f}};
+    const float want[5] = {0.0f, 1.0f, 0.5f, 0.0f, 1.0f};
+    for (int k = 0; k < 5; k++) {
+        float w = rs_makeup_field_weight(&f, at[k]);
+        RS_CHECK(fabsf(w - want[k]) < 1e-4f, "point %d: weight %.4f, want %.4f", k, w, want[k]);
+    }
+    const float p[3] = {0.7f, 0.5f, 0.5f};  // 0.2 of the way: f 0.2, ramp (0.2 - 0.5) / 0.2 + 0.5 < 0 -> 0
+    RS_CHECK(rs_makeup_field_weight(&f, p) == 0.0f, "below the band: %.4f", rs_makeup_field_weight(&f, p));
+    RS_CHECK(rs_makeup_field_weight(NULL, p) == 1.0f, "no field: not 1");
+}
+
 static void test_masked_stamp_paints_only_its_region_and_the_eraser_is_never_masked(void)
 {
     rs_splat_cloud *c = split_plane();
@@ -994,6 +1012,7 @@ int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
     RS_RUN(test_eq3_intensity_is_weighted_sum_at_brush_centre);
+    RS_RUN(test_field_weight_interpolates_and_ramps_like_the_shader);
     RS_RUN(test_eq2_blend_is_linear_and_zero_record_is_base);
     RS_RUN(test_composition_of_two_products_equals_sequential_blends);
     RS_RUN(test_foundation_shades_darken_in_order);

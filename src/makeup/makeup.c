@@ -1078,6 +1078,27 @@ const rs_makeup_field *rs_makeup_region_field(const rs_makeup *mk, rs_cosmetic_r
     return &mk->field[region];
 }
 
+float rs_makeup_field_weight(const rs_makeup_field *f, const float p[3])
+{
+    if (!f || !f->value) return 1.0f;
+    int i0[3];
+    float fr[3];
+    for (int a = 0; a < 3; a++) {
+        // Voxel centres at (i + .5) * voxel, clamped within the box like the shader's texture coordinates.
+        float t = RS_CLAMP((p[a] - f->origin[a]) / f->voxel - 0.5f, 0.0f, (float)(f->dim[a] - 1));
+        i0[a] = RS_MIN((int)t, RS_MAX(f->dim[a] - 2, 0));
+        fr[a] = f->dim[a] > 1 ? t - (float)i0[a] : 0.0f;
+    }
+    float v = 0.0f;
+    for (int c = 0; c < 8; c++) {
+        int x = i0[0] + (c & 1), y = i0[1] + (c >> 1 & 1), z = i0[2] + (c >> 2);
+        float w = ((c & 1) ? fr[0] : 1.0f - fr[0]) * ((c >> 1 & 1) ? fr[1] : 1.0f - fr[1]) *
+                  ((c >> 2) ? fr[2] : 1.0f - fr[2]);
+        if (w > 0.0f) v += w * f->value[((size_t)z * f->dim[1] + y) * f->dim[0] + x];
+    }
+    return RS_CLAMP((v / 255.0f - f->threshold) / f->band + 0.5f, 0.0f, 1.0f);
+}
+
 // The region whose field masks a (non-eraser) stamp per pixel, or 0: a brush kept to a region with a
 // field, wider than the fine radius (a pencil is its own mask: a lip or eye pencil traces the region's
 // border and would be cut in half by it).

@@ -200,6 +200,9 @@ bool rs_makeup_is_fine(const rs_makeup *mk, float radius);
 // NULL for other regions, before the mask is built, or where the face has no such region. Brushes kept
 // to a region with a field are drawn per pixel, masked by it.
 const rs_makeup_field *rs_makeup_region_field(const rs_makeup *mk, rs_cosmetic_region region);
+// The field's weight at a model-space point, as the renderer samples it (makeup_fine.glsl
+// rs_fine_region_weight: trilinear, clamped to the field's box, ramped); 1 where there is no field.
+float rs_makeup_field_weight(const rs_makeup_field *f, const float p[3]);
 // Counts every change of the stamp log (stamp, undo, redo, clear, reset, cancel): the renderer re-reads
 // the fine layer when it moves.
 uint32_t rs_makeup_fine_version(const rs_makeup *mk);

@@ -79,6 +79,7 @@ typedef struct fine_set {
     uint32_t count;
     fine_product *products;        // by log cosmetic index
     uint32_t product_count;
+    const rs_makeup_field *fields[RS_COSMETIC_REGION_COUNT];  // the region masks (rs_makeup_region_field)
 } fine_set;
 
 static void fine_free(fine_set *f)
@@ -100,6 +101,7 @@ static rs_result fine_load(const rs_makeup *mk, const float pos[3], float radius
     }
     f->count = keep;
     if (keep == 0) return RS_OK;
+    for (int g = 1; g < RS_COSMETIC_REGION_COUNT; g++) f->fields[g] = rs_makeup_region_field(mk, (rs_cosmetic_region)g);
     f->product_count = rs_makeup_log_cosmetic_count(mk);
     f->products = rs_alloc_array(f->product_count ? f->product_count : 1, sizeof *f->products);
     if (!f->products) return rs_fail(err, RS_ERR_NOMEM, "smudge: out of memory");
@@ -144,12 +146,16 @@ static layer fine_at(const fine_set *f, const float pm[3], const float nm[3])
         }
         const float *v = s->view_dir;
         float vl = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        if (vl > 0.0f && nm[0] * v[0] + nm[1] * v[1] + nm[2] * v[2] <= RS_MAKEUP_FACING_MIN * vl) continue;
+        // As makeup_fine.glsl: a product kept to a region needs the surface to face the view at all.
+        float facing_min = s->region ? 0.0f : RS_MAKEUP_FACING_MIN;
+        if (vl > 0.0f && nm[0] * v[0] + nm[1] * v[1] + nm[2] * v[2] <= facing_min * vl) continue;
         eraser = s->eraser != 0;
         product = !eraser && s->cosmetic < f->product_count ? &f->products[s->cosmetic] : NULL;
         if (!eraser && !product) continue;
         float dx = pm[0] - s->pos[0], dy = pm[1] - s->pos[1], dz = pm[2] - s->pos[2];
         float ig = rs_makeup_tip_falloff(sqrtf(dx * dx + dy * dy + dz * dz), s->radius, eraser ? 0.0f : product->hard);
+        if (s->region && ig > 0.0f)  // kept to a region: fills its mask within the brush's reach (the shader)
+            ig = RS_MIN(1.0f, 4.0f * ig) * rs_makeup_field_weight(s->region < RS_COSMETIC_REGION_COUNT ? f->fields[s->region] : NULL, pm);
         if (!(ig > 0.0f)) continue;
         if (!reached && !eraser) touches += 1.0f;
         reached = true;
