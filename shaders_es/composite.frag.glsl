@@ -328,7 +328,10 @@ void main()
         if (u_mode == MODE_DIFFUSE) c = A * Dd;
         else if (u_mode == MODE_SPECULAR) c = S + C;
         else if (u_mode == MODE_IRRADIANCE) c = E;
-        else c = (u_physical == 1 ? A * Dd + S : A * (Dd + S)) + C;
+        else {
+            vec3 Aw = rs_fine_wet(A, coat, dot(N, V));  // the body seen through the coat (makeup_fine.glsl)
+            c = (u_physical == 1 ? Aw * Dd + S : Aw * (Dd + S)) + C;
+        }
         c *= u_exposure;
         if (u_tonemap == 0 && u_linear_output < 0.5) c = filmic(c);
     }

@@ -90,6 +90,30 @@ void rs_fine_stack(inout rs_fine_layer l, float a, int p, bool eraser, inout flo
     }
 }
 
+// The body colour seen through a clear wet coat (gloss, a satin's oil), its coverage `coat`, at N.V `ndotv`.
+// A smooth film of index n = 1.5 over a diffuse surface of albedo a (Lekner & Dorf 1988, "Why some things
+// are darker when wet"): light enters through the film (1 - r_e, its hemispherical mean 0.092 for the
+// lighting from all around), is scattered back by the surface, and leaves towards the eye through the
+// film's upper face (1 - F(theta_v)), radiance / n^2; what is beyond the critical angle (r_i = 1 - (1 -
+// r_e) / n^2 = 0.596) is reflected back down and scattered again, and absorbed by the pigment each time:
+//   a_wet / a = (1 - F(theta_v)) (1 - r_e) / (n^2 (1 - a r_i)),
+// about 0.96 for a white, 0.43 for a dark pigment: the wet colour is deeper and more saturated. A gloss
+// over lipstick does not wet all of it so: where the product's wax already holds its pigment at the same
+// index the film adds no new interface; only the porous, air-filled top of a (satin or matte) film fills
+// with the oil. RS_COAT_WETTING is that share (chosen, not measured). The coat's reflection is the
+// composite's clear-coat lobe (smooth, from the lamps and the whole room); the light it reflects is the
+// light this transmission loses. Only `full` applies it: `diffuse` shows the dry surface's subsurface
+// term, the coat (what it reflects and what it does to the light through it) being a layer above.
+#define RS_COAT_WETTING 0.5
+vec3 rs_fine_wet(vec3 a, float coat, float ndotv)
+{
+    if (coat <= 0.0) return a;
+    const float n2 = 2.25, r_e = 0.092, r_i = 1.0 - (1.0 - r_e) / n2;
+    float fv = 0.04 + 0.96 * pow(1.0 - clamp(ndotv, 0.0, 1.0), 5.0);
+    vec3 ratio = (1.0 - fv) * (1.0 - r_e) / (n2 * (1.0 - a * r_i));
+    return a * mix(vec3(1.0), ratio, RS_COAT_WETTING * clamp(coat, 0.0, 1.0));
+}
+
 // Composes the fine layer at model-space point pm (unit normal nm) over the splat layer's values.
 void rs_fine_apply(vec3 pm, vec3 nm, inout vec3 albedo, inout float m, inout float rho_s, inout float coat,
                    inout float shimmer)

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+
 #define FACE_PATH "assets/face.rsf"
 
 static rouge_face *face;
@@ -163,15 +164,13 @@ static void test_liner_is_one_crisp_even_dark_line_on_both_sides(void)
     rouge_view m = v;
     m.yaw_deg = -v.yaw_deg, m.pan[0] = -v.pan[0];
     uint8_t *bare = NULL, *paint = NULL, *mbare = NULL, *mpaint = NULL;
-    RS_REQUIRE(render(w, h, &bare), "bare render");
     rouge_face_set_view(face, &m, &e);
     RS_REQUIRE(render(w, h, &mbare), "bare mirrored render");
     rouge_face_set_view(face, &v, &e);
-    RS_REQUIRE(render(w, h, &paint), "render");  // the pointer's frame
+    RS_REQUIRE(render(w, h, &bare), "bare render");  // also the pointer's frame
     RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "eyeliner", .mirror = true, .opacity = 1.0f},
                                     &e) == ROUGE_OK, "brush: %s", e.msg);
     stroke(0.25f * w, 0.5f * h, 0.75f * w, 0.47f * h, 40);
-    free(paint);
     RS_REQUIRE(render(w, h, &paint), "painted render");
     rouge_face_set_view(face, &m, &e);
     RS_REQUIRE(render(w, h, &mpaint), "painted mirrored render");
@@ -185,19 +184,6 @@ static void test_liner_is_one_crisp_even_dark_line_on_both_sides(void)
     free(bare), free(paint), free(mbare), free(mpaint);
     rouge_face_set_view(face, &v, &e);
     rouge_face_clear(face, &e);
-}
-
-// The lips' pixels of the current frame (the pick's region 4).
-static uint8_t *lips_pixels(int w, int h, int *count)
-{
-    uint8_t *mask = calloc((size_t)w * h, 1);
-    *count = 0;
-    for (int y = 0; mask && y < h; y++)
-        for (int x = 0; x < w; x++) {
-            rouge_pick p;
-            if (rouge_face_pick(face, x + 0.5f, y + 0.5f, &p) && p.region == 4) mask[(size_t)y * w + x] = 1, (*count)++;
-        }
-    return mask;
 }
 
 // Writes tests/fixtures/strokes/lips.strokes with another cosmetic into the test folder; its path.
@@ -248,13 +234,15 @@ static void test_gloss_over_lipstick_reads_in_the_default_front_view(void)
         rouge_face_set_view(face, &v, &e);
         RS_REQUIRE(render(512, 512, &lip[k]), "render");
     }
-    // The lip pixels: the lips region where the lipstick shows (the region reaches onto the skin around).
+    // The lip pixels: the lips region (the pick's region 4) where the lipstick shows (the region reaches
+    // onto the skin around). Only the pixels the lipstick changed are picked: a pick per pixel costs seconds.
     int n = 0;
-    uint8_t *mask = lips_pixels(512, 512, &n);
+    uint8_t *mask = calloc(512 * 512, 1);
     for (int i = 0; mask && i < 512 * 512; i++) {
         int d = 0;
         for (int c = 0; c < 3; c++) d = RS_MAX(d, abs(bare[4 * i + c] - lip[0][4 * i + c]));
-        if (mask[i] && d < 10) mask[i] = 0, n--;
+        rouge_pick p;
+        if (d >= 10 && rouge_face_pick(face, i % 512 + 0.5f, i / 512 + 0.5f, &p) && p.region == 4) mask[i] = 1, n++;
     }
     free(bare);
     RS_REQUIRE(n > 500, "only %d lip pixels", n);
@@ -271,22 +259,18 @@ static void test_gloss_over_lipstick_reads_in_the_default_front_view(void)
     lip_change(lip[1], gloss[1], mask, n, &dmed, &dp95);
     printf("# gloss over lipstick, %d lip pixels: full median %d p95 %d; diffuse median %d p95 %d\n", n, med, p95,
            dmed, dp95);
-    // Issue 21's goal (median >= 8, p95 >= 15 in full, <= 8 in diffuse) is not met yet: under the studio
-    // environment the lips face drapes and ceiling, not lamps. Over these lips' normals the studio's
-    // radiance in the mirror direction times the coat's Fresnel (F0 0.04, n 1.5) has a median of ~0.004
-    // (linear; for any coat roughness 0.1-0.4 the key adds >= 0.011 to under a quarter of them), ~3/255; 8/255
-    // needs ~0.011, the Fresnel of n ~2, not a gloss oil (n 1.47-1.50). A colour change that would carry the
-    // median shows in `diffuse` as much as in `full`. Until then the test guards today's numbers (median 3,
-    // p95 23, diffuse 0) against regressions and reports the goal as a skip.
-    bool goal = med >= 8 && p95 >= 15 && dmed <= 8, held = med >= 3 && p95 >= 20 && dmed <= 8;
-    RS_CHECK(goal || held,
-             "gloss reads less than it did: full median %d (was 3), p95 %d (was 23), diffuse median %d", med, p95,
-             dmed);
+    // Issue 21's goal: median >= 8, p95 >= 15 in full, <= 8 in diffuse. Under the studio environment the
+    // lips mirror drapes and ceiling, not lamps: the coat's reflection alone (F0 0.04) moves the median lip
+    // pixel by ~3/255 (the p95 is its highlights). What carries the median is what a wet film does to the
+    // colour under it (makeup_fine.glsl rs_fine_wet, Lekner & Dorf): deeper, more saturated. `diffuse` is
+    // the dry surface's subsurface term; the coat is a layer above it, so it does not change there.
+    // Before that model: full median 4, p95 26, diffuse 0.
+    RS_CHECK(med >= 8 && p95 >= 15 && dmed <= 8,
+             "gloss over lipstick: full median %d/255 (goal >= 8), p95 %d (>= 15), diffuse median %d (<= 8)", med,
+             p95, dmed);
     for (int k = 0; k < 2; k++) free(lip[k]), free(gloss[k]);
     free(mask);
     rouge_face_clear(face, &e);
-    if (!goal && held)
-        rs_test_skip("issue 21's goal not met yet: full median %d/255 (goal >= 8), p95 %d (>= 15)", med, p95);
 }
 
 // CIELAB a* of an sRGB8 pixel (D65): the red-green axis that tells the vermilion from the skin.
@@ -302,27 +286,42 @@ static double lab_a(const uint8_t *p)
     return 500.0 * (fx - fy);
 }
 
-// The lips of a bare close-up, as a makeup artist sees them: pixels of the lips region (the pick's region
-// 4, which reaches onto the skin around) whose colour is the vermilion's (a*, smoothed over 5x5 pixels
-// against the skin's texture, above Otsu's threshold between the region's two colour classes). 1 upper
-// lip, 2 lower lip (above / below the mouth line: per column, the darkest pixel between them), 0 not lip;
-// the outer borders smoothed along the mouth.
-static uint8_t *lips_truth(const uint8_t *bare, int w, int h, int *mouth_y)
+// The lips region (the pick's region 4, a blob around the mouth that reaches onto the skin) over the middle
+// of a close-up (rouge_face_target centres the lips), picked at the centre of every 3x3 block: the mask only
+// bounds where the colour is asked, its own border is splat-ragged, and a pick per pixel costs seconds.
+static uint8_t *lips_region(int w, int h)
 {
-    uint8_t *region = calloc((size_t)w * h, 1), *lip = calloc((size_t)w * h, 1);
+    uint8_t *region = calloc((size_t)w * h, 1);
+    for (int by = h / 5; region && by < h * 4 / 5; by += 3)
+        for (int bx = w / 10; bx < w * 9 / 10; bx += 3) {
+            rouge_pick p;
+            if (!rouge_face_pick(face, bx + 1.5f, by + 1.5f, &p) || p.region != 4) continue;
+            for (int y = by; y < RS_MIN(by + 3, h); y++) memset(region + (size_t)y * w + bx, 1, (size_t)RS_MIN(3, w - bx));
+        }
+    return region;
+}
+
+// The lips of a bare close-up, as a makeup artist sees them: where the scan's own colour changes from skin
+// to vermilion. The truth is read from the albedo view at the same camera (rouge's ALBEDO mode: the
+// splats' colour, no light), so the same lips give the same border under any lighting; it shares nothing
+// with the lips' field the lipstick is masked by (a different source: pixels, not splats; no 3D blur),
+// so the check can fail. Within the lips region, pixels whose a* (CIELAB, smoothed over 5x5 pixels against
+// the skin's texture) is above Otsu's threshold between the region's two colour classes are lip colour.
+// 1 upper lip, 2 lower lip (above / below the mouth line: per column, the darkest albedo pixel between
+// them), 0 not lip; the outer borders smoothed along the mouth.
+static uint8_t *lips_truth(const uint8_t *albedo, int w, int h, int *mouth_y)
+{
+    const uint8_t *bare = albedo;
+    uint8_t *region = lips_region(w, h), *lip = calloc((size_t)w * h, 1);
     double *a = calloc((size_t)w * h, sizeof *a);
     int hist[256] = {0}, total = 0, *tops = calloc((size_t)w, sizeof *tops), *bottoms = calloc((size_t)w, sizeof *bottoms);
-    // The close-up centres the lips (rouge_face_target): only the middle of the frame is asked (picks are slow).
-    for (int y = h / 5; y < h * 4 / 5; y++)
-        for (int x = w / 10; x < w * 9 / 10; x++) {
-            rouge_pick p;
-            region[(size_t)y * w + x] = rouge_face_pick(face, x + 0.5f, y + 0.5f, &p) && p.region == 4;
-        }
+    double *a1 = malloc(sizeof *a1 * (size_t)w * h);  // a* per pixel, then its 5x5 mean in a
+    for (size_t i = 0; i < (size_t)w * h; i++) a1[i] = lab_a(bare + 4 * i);
     for (int y = 2; y < h - 2; y++)
         for (int x = 2; x < w - 2; x++) {
             size_t i = (size_t)y * w + x;
             if (!region[i]) continue;
-            for (int k = 0; k < 25; k++) a[i] += lab_a(bare + ((size_t)(y + k / 5 - 2) * w + (x + k % 5 - 2)) * 4) / 25.0;
+            for (int k = 0; k < 25; k++) a[i] += a1[(size_t)(y + k / 5 - 2) * w + (x + k % 5 - 2)] / 25.0;
             hist[RS_CLAMP((int)(a[i] * 4.0), 0, 255)]++, total++;
         }
     double sum = 0, s0 = 0, w0 = 0, best = -1;
@@ -364,7 +363,7 @@ static uint8_t *lips_truth(const uint8_t *bare, int w, int h, int *mouth_y)
             if (mouth_y[j] >= 0) st += tops[j], sb += bottoms[j], n++;
         for (int y = (int)lrint(st / n); y <= (int)lrint(sb / n); y++) lip[(size_t)y * w + x] = y < mouth_y[x] ? 1 : 2;
     }
-    free(region), free(a), free(tops), free(bottoms);
+    free(region), free(a), free(a1), free(tops), free(bottoms);
     return lip;
 }
 
@@ -414,10 +413,18 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
     v = rouge_face_get_view(face);
     printf("# lips close-up: zoom %.2f\n", v.zoom);
     uint8_t *bare = NULL, *paint = NULL;
+    uint8_t *albedo = NULL;
+    v.mode = ROUGE_MODE_ALBEDO;
+    rouge_face_set_view(face, &v, &e);
+    RS_REQUIRE(render(w, h, &albedo), "albedo render");
+    v.mode = ROUGE_MODE_FULL;
+    rouge_face_set_view(face, &v, &e);
     RS_REQUIRE(render(w, h, &bare), "bare render");
     save("lipstick_lips_3x_bare", bare, w, h);
+    save("lipstick_lips_3x_albedo", albedo, w, h);
     int *mouth = malloc(sizeof *mouth * (size_t)w);
-    uint8_t *lip = lips_truth(bare, w, h, mouth);
+    uint8_t *lip = lips_truth(albedo, w, h, mouth);
+    free(albedo);
     // Each lip's extent and centre line (per column, the middle of its pixels).
     int x0[3] = {w, w, w}, x1[3] = {0, 0, 0}, count[3] = {0};
     double *mid[3] = {NULL, calloc((size_t)w, sizeof(double)), calloc((size_t)w, sizeof(double))};
@@ -436,7 +443,7 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
     // The lipstick's full colour at every pixel: the mouth and the skin around painted over anywhere
     // with a wide brush, three times.
     uint8_t *full = NULL;
-    RS_REQUIRE(render(w, h, &paint), "render");  // the pointer's frame
+    // (The bare render, the last frame, is the pointer's frame.)
     RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "lipstick_matte", .opacity = 1.0f, .size = 0.2f,
                                                          .any_region = true}, &e) == ROUGE_OK, "brush: %s", e.msg);
     for (int pass = 0; pass < 3; pass++) stroke(0.15f * w, 0.5f * h, 0.85f * w, 0.5f * h, 40);
@@ -457,7 +464,6 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
             ev.type = ROUGE_POINTER_UP;
             rouge_face_pointer(face, &ev, NULL, &e);
         }
-    free(paint);
     RS_REQUIRE(render(w, h, &paint), "painted render");
     save("lipstick_lips_3x", paint, w, h);
     // Coverage per pixel: how far the paint moved the pixel from the bare face towards the full colour.
@@ -485,6 +491,22 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
             }
             spill += !near;
         }
+    // The painted close-up with the truth's border drawn over it (green), the lip pixels it leaves
+    // uncovered (blue) and its spill (yellow), to look at.
+    uint8_t *drawn = malloc((size_t)w * h * 4);
+    memcpy(drawn, paint, (size_t)w * h * 4);
+    for (int y = 1; y < h - 1; y++)
+        for (int x = 1; x < w - 1; x++) {
+            size_t i = (size_t)y * w + x;
+            if (lip[i] && (!lip[i - 1] || !lip[i + 1] || !lip[i - w] || !lip[i + w]))
+                memcpy(drawn + 4 * i, (uint8_t[4]){0, 255, 0, 255}, 4);
+            else if (lip[i] && d[i] < level)
+                memcpy(drawn + 4 * i, (uint8_t[4]){0, 0, 255, 255}, 4);
+            else if (!lip[i] && d[i] >= level)
+                memcpy(drawn + 4 * i, (uint8_t[4]){255, 255, 0, 255}, 4);
+        }
+    save("lipstick_lips_3x_truth", drawn, w, h);
+    free(drawn);
     // The outer edges: the upper lip's top and the lower lip's bottom, over the middle 80 % of each lip.
     double *top = malloc(sizeof(double) * (size_t)w), *bottom = malloc(sizeof(double) * (size_t)w);
     for (int x = 0; x < w; x++) {
@@ -499,22 +521,19 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
            100 * sp, wt, wb);
     // Issue 21's goal (>= 95 % of each lip, <= 0.5 % spill, edges within 1 px of their smoothed lines) is
     // not met yet. The lipstick is drawn per pixel, masked by the lips' field (makeup.c, "Region masks per
-    // pixel") and fills it within the brush's reach (makeup_fine.glsl): the upper lip now takes the paint
-    // down to the mouth line. The field's 0.5 line is not yet the border this test reads from the picture:
-    // it runs outside it at the lower lip's left side and the upper lip's corners (the spill) and inside it
-    // at the lower lip's right end (the rendered a* carries the key light's side, the field the albedo's);
-    // the cupid's bow is flatter. Until it is, today's numbers (94.4 / 96.6 %, spill 5.6 %, wander
-    // 0.78 / 1.70 px; with the stroke's falloff as the fill and the 0.2 facing test they were 86.8 / 95.5 %,
-    // 4.2 %, 0.81 / 1.66 px, measured against the truth that still held the philtrum) are guarded against
-    // regressions. Raising the field's cut (makeup.c, 0.5) trades spill for cover: at 0.55 92.4 / 91.2 %,
-    // 2.7 %; at 0.6 85.6 / 83.1 %, 0.45 %. The truth is read from the lit picture: with the bounce light
-    // (issue 22) the same painted pixels measure 93.6 / 96.4 %, spill 9.7 %, wander 0.78 / 1.72 px, the
-    // numbers guarded now (the lipstick itself did not change).
+    // pixel": the splats' a* about their Otsu cut, over 4.5 mm, the cut 2 a* lower) and fills it within
+    // the brush's reach (makeup_fine.glsl). The truth is the albedo's border (lips_truth), so lighting
+    // does not move it: with it, the former field (3 mm, the cut at Otsu's) measured 88.9 / 91.9 %, spill
+    // 0.38 %, wander 0.67 / 1.66 px; against the lit picture's truth it had measured 93.6 / 96.4 %, 9.7 %,
+    // 0.78 / 1.72 px. What is left (lipstick_lips_3x_truth.png: blue uncovered, yellow spill): the mouth
+    // line's own pixels on the upper lip (the field there mixes in the mouth's inside), the top of the
+    // cupid's bow, and lumps of the albedo's lower border that the smooth field cuts across; the spill is
+    // along the upper lip's outer thirds. Today's numbers are guarded against regressions.
     bool goal = cu >= 0.95 && cl >= 0.95 && sp <= 0.005 && wt <= 1.0 && wb <= 1.0;
-    bool held = cu >= 0.93 && cl >= 0.955 && sp <= 0.10 && wt <= 0.85 && wb <= 1.8;
+    bool held = cu >= 0.91 && cl >= 0.935 && sp <= 0.035 && wt <= 0.7 && wb <= 1.2;
     RS_CHECK(goal || held,
-             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 93.6 / 96.4), spill %.2f %% (was 9.66), "
-             "edges wander %.2f / %.2f px (were 0.78 / 1.72)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
+             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 91.7 / 94.1), spill %.2f %% (was 2.97), "
+             "edges wander %.2f / %.2f px (were 0.61 / 1.13)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
     free(top), free(bottom), free(d), free(full), free(mid[1]), free(mid[2]), free(lip), free(mouth);
     free(bare), free(paint);
     rouge_face_clear(face, &e);
