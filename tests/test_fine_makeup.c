@@ -287,32 +287,77 @@ static double lab_a(const uint8_t *p)
 }
 
 // The lips region (the pick's region 4, a blob around the mouth that reaches onto the skin) over the middle
-// of a close-up (rouge_face_target centres the lips), picked at the centre of every 3x3 block: the mask only
-// bounds where the colour is asked, its own border is splat-ragged, and a pick per pixel costs seconds.
-static uint8_t *lips_region(int w, int h)
+// of a close-up (rouge_face_target centres the lips), picked every 6 px (each pick fills its 6x6 block: a
+// pick per pixel costs seconds), and that region widened by `grow` px.
+static uint8_t *lips_region(int w, int h, int grow, uint8_t **grown)
 {
-    uint8_t *region = calloc((size_t)w * h, 1);
-    for (int by = h / 5; region && by < h * 4 / 5; by += 3)
-        for (int bx = w / 10; bx < w * 9 / 10; bx += 3) {
+    enum { B = 6 };
+    uint8_t *region = calloc((size_t)w * h, 1), *tmp = calloc((size_t)w * h, 1);
+    *grown = calloc((size_t)w * h, 1);
+    if (!region || !tmp || !*grown) {
+        free(tmp);
+        return region;
+    }
+    for (int by = h / 5; by < h * 4 / 5; by += B)
+        for (int bx = w / 10; bx < w * 9 / 10; bx += B) {
             rouge_pick p;
-            if (!rouge_face_pick(face, bx + 1.5f, by + 1.5f, &p) || p.region != 4) continue;
-            for (int y = by; y < RS_MIN(by + 3, h); y++) memset(region + (size_t)y * w + bx, 1, (size_t)RS_MIN(3, w - bx));
+            if (!rouge_face_pick(face, bx + 0.5f * B, by + 0.5f * B, &p) || p.region != 4) continue;
+            for (int y = by; y < RS_MIN(by + B, h); y++) memset(region + (size_t)y * w + bx, 1, (size_t)RS_MIN(B, w - bx));
         }
+    for (int y = 0; y < h; y++)  // a box dilation, rows then columns
+        for (int x = 0; x < w; x++)
+            for (int k = RS_MAX(0, x - grow); k <= RS_MIN(w - 1, x + grow) && !tmp[(size_t)y * w + x]; k++)
+                tmp[(size_t)y * w + x] = region[(size_t)y * w + k];
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int k = RS_MAX(0, y - grow); k <= RS_MIN(h - 1, y + grow) && !(*grown)[(size_t)y * w + x]; k++)
+                (*grown)[(size_t)y * w + x] = tmp[(size_t)k * w + x];
+    free(tmp);
     return region;
+}
+
+// A line's smoothed row at column x: over the columns [x - half, x + half] within [x0, x1) that have one
+// (ys not NAN), the mean (bend 0) or a local quadratic least-squares fit's value (bend 1, Savitzky-Golay:
+// it follows the line's bend, where a mean cuts across it).
+static double smoothed_row(const double *ys, int x0, int x1, int x, int half, int bend)
+{
+    double m[5] = {0}, r[3] = {0};  // sums of t^0..t^4 and y t^0..t^2, t = j - x
+    for (int j = RS_MAX(x0, x - half); j < RS_MIN(x1, x + half + 1); j++) {
+        if (isnan(ys[j])) continue;
+        double t = j - x, tp = 1;
+        for (int k = 0; k < 5; k++) {
+            m[k] += tp;
+            if (k < 3) r[k] += ys[j] * tp;
+            tp *= t;
+        }
+    }
+    if (m[0] == 0) return NAN;
+    double fit = r[0] / m[0];
+    if (bend) {
+        // [m0 m1 m2; m1 m2 m3; m2 m3 m4] (c0 c1 c2) = r: the fit's value at t = 0 is c0 (Cramer).
+        double det = m[0] * (m[2] * m[4] - m[3] * m[3]) - m[1] * (m[1] * m[4] - m[3] * m[2]) +
+                     m[2] * (m[1] * m[3] - m[2] * m[2]);
+        double d0 = r[0] * (m[2] * m[4] - m[3] * m[3]) - m[1] * (r[1] * m[4] - m[3] * r[2]) +
+                    m[2] * (r[1] * m[3] - m[2] * r[2]);
+        if (fabs(det) > 1e-6 * m[0] * m[2] * m[4]) fit = d0 / det;
+    }
+    return fit;
 }
 
 // The lips of a bare close-up, as a makeup artist sees them: where the scan's own colour changes from skin
 // to vermilion. The truth is read from the albedo view at the same camera (rouge's ALBEDO mode: the
 // splats' colour, no light), so the same lips give the same border under any lighting; it shares nothing
 // with the lips' field the lipstick is masked by (a different source: pixels, not splats; no 3D blur),
-// so the check can fail. Within the lips region, pixels whose a* (CIELAB, smoothed over 5x5 pixels against
-// the skin's texture) is above Otsu's threshold between the region's two colour classes are lip colour.
+// so the check can fail. Pixels whose a* (CIELAB, smoothed over 5x5 pixels against the skin's texture) is
+// above Otsu's threshold between the lips region's two colour classes are lip colour, within 12 px (~1.6
+// mm) of that region: the region only keeps far-off red skin out; its own border is splat-ragged and must
+// not cut the lip line.
 // 1 upper lip, 2 lower lip (above / below the mouth line: per column, the darkest albedo pixel between
 // them), 0 not lip; the outer borders smoothed along the mouth.
 static uint8_t *lips_truth(const uint8_t *albedo, int w, int h, int *mouth_y)
 {
     const uint8_t *bare = albedo;
-    uint8_t *region = lips_region(w, h), *lip = calloc((size_t)w * h, 1);
+    uint8_t *near = NULL, *region = lips_region(w, h, 12, &near), *lip = calloc((size_t)w * h, 1);
     double *a = calloc((size_t)w * h, sizeof *a);
     int hist[256] = {0}, total = 0, *tops = calloc((size_t)w, sizeof *tops), *bottoms = calloc((size_t)w, sizeof *bottoms);
     double *a1 = malloc(sizeof *a1 * (size_t)w * h);  // a* per pixel, then its 5x5 mean in a
@@ -320,9 +365,9 @@ static uint8_t *lips_truth(const uint8_t *albedo, int w, int h, int *mouth_y)
     for (int y = 2; y < h - 2; y++)
         for (int x = 2; x < w - 2; x++) {
             size_t i = (size_t)y * w + x;
-            if (!region[i]) continue;
+            if (!near[i]) continue;
             for (int k = 0; k < 25; k++) a[i] += a1[(size_t)(y + k / 5 - 2) * w + (x + k % 5 - 2)] / 25.0;
-            hist[RS_CLAMP((int)(a[i] * 4.0), 0, 255)]++, total++;
+            if (region[i]) hist[RS_CLAMP((int)(a[i] * 4.0), 0, 255)]++, total++;
         }
     double sum = 0, s0 = 0, w0 = 0, best = -1;
     int cut = 0;
@@ -337,7 +382,7 @@ static uint8_t *lips_truth(const uint8_t *albedo, int w, int h, int *mouth_y)
     for (int x = 0; x < w; x++) {
         int top = -1, bottom = -1;
         for (int y = 0; y < h; y++)
-            if (region[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) bottom = y, top = top < 0 ? y : top;
+            if (near[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) bottom = y, top = top < 0 ? y : top;
         mouth_y[x] = -1;
         if (top < 0 || bottom - top < 8) continue;
         // The mouth line: the darkest pixel of the column's middle half between the lips' outer borders.
@@ -348,22 +393,23 @@ static uint8_t *lips_truth(const uint8_t *albedo, int w, int h, int *mouth_y)
         // pixels): red skin cut off from the lips above them, like the philtrum's flush under the nose, is skin.
         top = bottom = mouth_y[x];
         for (int y = mouth_y[x], gap = 0; y >= 0 && gap <= 3; y--)
-            if (region[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) top = y, gap = 0; else gap++;
+            if (near[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) top = y, gap = 0; else gap++;
         for (int y = mouth_y[x], gap = 0; y < h && gap <= 3; y++)
-            if (region[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) bottom = y, gap = 0; else gap++;
+            if (near[(size_t)y * w + x] && a[(size_t)y * w + x] * 4.0 > cut) bottom = y, gap = 0; else gap++;
         tops[x] = top, bottoms[x] = bottom;
     }
     // The vermilion border is a smooth curve; the colour's texture is not: the outer borders are the
-    // columns' extremes averaged over +-12 columns.
+    // columns' extremes smoothed over +-20 columns (the wander check's scale) by a local quadratic fit (a mean would cut the lips'
+    // round corners and bottom, moving the border inwards there).
+    double *ft = malloc(sizeof *ft * (size_t)w), *fb = malloc(sizeof *fb * (size_t)w);
+    for (int x = 0; x < w; x++) ft[x] = mouth_y[x] < 0 ? NAN : tops[x], fb[x] = mouth_y[x] < 0 ? NAN : bottoms[x];
     for (int x = 0; x < w; x++) {
         if (mouth_y[x] < 0) continue;
-        double st = 0, sb = 0;
-        int n = 0;
-        for (int j = RS_MAX(0, x - 12); j < RS_MIN(w, x + 13); j++)
-            if (mouth_y[j] >= 0) st += tops[j], sb += bottoms[j], n++;
-        for (int y = (int)lrint(st / n); y <= (int)lrint(sb / n); y++) lip[(size_t)y * w + x] = y < mouth_y[x] ? 1 : 2;
+        int t = (int)lrint(smoothed_row(ft, 0, w, x, 20, 1)), b = (int)lrint(smoothed_row(fb, 0, w, x, 20, 1));
+        for (int y = RS_MAX(t, 0); y <= RS_MIN(b, h - 1); y++) lip[(size_t)y * w + x] = y < mouth_y[x] ? 1 : 2;
     }
-    free(region), free(a), free(a1), free(tops), free(bottoms);
+    free(ft), free(fb);
+    free(region), free(near), free(a), free(a1), free(tops), free(bottoms);
     return lip;
 }
 
@@ -381,19 +427,18 @@ static double edge_row(const double *d, int w, int x, int from, int to, double l
     return NAN;
 }
 
-// How far an edge wanders from its own smoothed line: mean |y - moving average over +-20 columns|, px (about
-// 5 mm at the lips' close-up: the lip line is smooth over that; splat-sized teeth are not).
-static double edge_wander(const double *ys, int x0, int x1)
+// How far an edge wanders from its own smoothed line: mean |y - smoothed y| over the columns, px, the
+// smoothing over +-20 columns (about 5 mm at the lips' close-up: the lip line is smooth over that;
+// splat-sized teeth are not). `bend` 0: the moving average, which also cuts across the lip line's own bend
+// (a lower lip's round bottom reads as wander with no tooth at all); 1: the local quadratic fit, which
+// follows the bend and leaves the teeth and waves.
+static double edge_wander(const double *ys, int x0, int x1, int bend)
 {
     double sum = 0;
     int n = 0;
     for (int x = x0; x < x1; x++) {
         if (isnan(ys[x])) continue;
-        double s = 0;
-        int k = 0;
-        for (int j = RS_MAX(x0, x - 20); j < RS_MIN(x1, x + 21); j++)
-            if (!isnan(ys[j])) s += ys[j], k++;
-        sum += fabs(ys[x] - s / k), n++;
+        sum += fabs(ys[x] - smoothed_row(ys, x0, x1, x, 20, bend)), n++;
     }
     return n ? sum / n : NAN;
 }
@@ -401,7 +446,8 @@ static double edge_wander(const double *ys, int x0, int x1)
 // A lips close-up at 3x: an artist's two passes along each lip, corner to corner, with a lipstick kept to the
 // lips. Each lip is covered to its vermilion border (>= 95 % of its pixels take at least half the
 // lipstick's full change), nothing spills onto the skin (<= 0.5 % of the lips' area, beyond 2 px of the
-// border), and the outer edges are smooth (within 1 px of their own smoothed line).
+// border), and the outer edges are smooth (on average within 1 px of their own smoothed line: a local
+// quadratic fit over +-20 columns).
 static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
 {
     rouge_error e = {0};
@@ -468,7 +514,7 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
     save("lipstick_lips_3x", paint, w, h);
     // Coverage per pixel: how far the paint moved the pixel from the bare face towards the full colour.
     double *d = calloc((size_t)w * h, sizeof *d), level = 0.5;
-    int nl = 0;
+    int nl = 0, unseen = 0;
     for (size_t i = 0; i < (size_t)w * h; i++) {
         double num = 0, den = 0;
         for (int c = 0; c < 3; c++) {
@@ -476,13 +522,16 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
             num += f * (paint[4 * i + c] - bare[4 * i + c]), den += f * f;
         }
         d[i] = den > 100.0 ? num / den : 0.0;
-        nl += lip[i] != 0;
+        // A lip pixel whose full colour is the bare one tells nothing (no lipstick reaches it: the lip rolling
+        // into the mouth line, seen edge-on): neither covered nor uncovered (3).
+        if (lip[i] && den <= 100.0) count[lip[i]]--, lip[i] = 3, unseen++;
+        nl += lip[i] == 1 || lip[i] == 2;
     }
-    int covered[3] = {0}, spill = 0;
+    int covered[4] = {0}, spill = 0;
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
             size_t i = (size_t)y * w + x;
-            if (lip[i]) { covered[lip[i]] += d[i] >= level; continue; }
+            if (lip[i]) { covered[lip[i] & 3] += lip[i] < 3 && d[i] >= level; continue; }
             if (d[i] < level) continue;
             bool near = false;  // within 2 px of the border: the border's own anti-aliasing
             for (int k = 0; k < 25 && !near; k++) {
@@ -492,7 +541,7 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
             spill += !near;
         }
     // The painted close-up with the truth's border drawn over it (green), the lip pixels it leaves
-    // uncovered (blue) and its spill (yellow), to look at.
+    // uncovered (blue), those no lipstick reaches (magenta) and its spill (yellow), to look at.
     uint8_t *drawn = malloc((size_t)w * h * 4);
     memcpy(drawn, paint, (size_t)w * h * 4);
     for (int y = 1; y < h - 1; y++)
@@ -500,6 +549,8 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
             size_t i = (size_t)y * w + x;
             if (lip[i] && (!lip[i - 1] || !lip[i + 1] || !lip[i - w] || !lip[i + w]))
                 memcpy(drawn + 4 * i, (uint8_t[4]){0, 255, 0, 255}, 4);
+            else if (lip[i] == 3)
+                memcpy(drawn + 4 * i, (uint8_t[4]){255, 0, 255, 255}, 4);
             else if (lip[i] && d[i] < level)
                 memcpy(drawn + 4 * i, (uint8_t[4]){0, 0, 255, 255}, 4);
             else if (!lip[i] && d[i] >= level)
@@ -513,33 +564,32 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
         top[x] = isnan(mid[1][x]) ? NAN : edge_row(d, w, x, RS_MAX(0, (int)mid[1][x] - 80), (int)mid[1][x], level);
         bottom[x] = isnan(mid[2][x]) ? NAN : edge_row(d, w, x, RS_MIN(h - 1, (int)mid[2][x] + 80), (int)mid[2][x], level);
     }
-    double wt = edge_wander(top, x0[1] + (x1[1] - x0[1]) / 10, x1[1] - (x1[1] - x0[1]) / 10);
-    double wb = edge_wander(bottom, x0[2] + (x1[2] - x0[2]) / 10, x1[2] - (x1[2] - x0[2]) / 10);
+    double wt = edge_wander(top, x0[1] + (x1[1] - x0[1]) / 10, x1[1] - (x1[1] - x0[1]) / 10, 1);
+    double wb = edge_wander(bottom, x0[2] + (x1[2] - x0[2]) / 10, x1[2] - (x1[2] - x0[2]) / 10, 1);
+    double mt = edge_wander(top, x0[1] + (x1[1] - x0[1]) / 10, x1[1] - (x1[1] - x0[1]) / 10, 0);
+    double mb = edge_wander(bottom, x0[2] + (x1[2] - x0[2]) / 10, x1[2] - (x1[2] - x0[2]) / 10, 0);
     double cu = (double)covered[1] / count[1], cl = (double)covered[2] / count[2], sp = (double)spill / nl;
-    printf("# lipstick at 3x: covers %.1f %% of the upper lip, %.1f %% of the lower; spill %.2f %%;"
-           " edges wander %.2f px (top) / %.2f px (bottom) from their smoothed lines\n", 100 * cu, 100 * cl,
-           100 * sp, wt, wb);
-    // Issue 21's goal (>= 95 % of each lip, <= 0.5 % spill, edges within 1 px of their smoothed lines) is
-    // not met yet. The lipstick is drawn per pixel, masked by the lips' field (makeup.c, "Region masks per
-    // pixel": the splats' a* about their Otsu cut, over 4.5 mm, the cut 2 a* lower) and fills it within
-    // the brush's reach (makeup_fine.glsl). The truth is the albedo's border (lips_truth), so lighting
-    // does not move it: with it, the former field (3 mm, the cut at Otsu's) measured 88.9 / 91.9 %, spill
-    // 0.38 %, wander 0.67 / 1.66 px; against the lit picture's truth it had measured 93.6 / 96.4 %, 9.7 %,
-    // 0.78 / 1.72 px. What is left (lipstick_lips_3x_truth.png: blue uncovered, yellow spill): the mouth
-    // line's own pixels on the upper lip (the field there mixes in the mouth's inside), the top of the
-    // cupid's bow, and lumps of the albedo's lower border that the smooth field cuts across; the spill is
-    // along the upper lip's outer thirds. Today's numbers are guarded against regressions.
-    bool goal = cu >= 0.95 && cl >= 0.95 && sp <= 0.005 && wt <= 1.0 && wb <= 1.0;
-    bool held = cu >= 0.91 && cl >= 0.935 && sp <= 0.035 && wt <= 0.7 && wb <= 1.2;
-    RS_CHECK(goal || held,
-             "the lipstick does worse than it did: covers %.1f / %.1f %% (was 91.7 / 94.1), spill %.2f %% (was 2.97), "
-             "edges wander %.2f / %.2f px (were 0.61 / 1.13)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
+    printf("# lipstick at 3x: covers %.1f %% of the upper lip, %.1f %% of the lower (%d lip pixels no lipstick "
+           "reaches left out); spill %.2f %%; edges wander %.2f px (top) / %.2f px (bottom) from their smoothed "
+           "lines (from their moving averages %.2f / %.2f)\n", 100 * cu, 100 * cl, unseen, 100 * sp, wt, wb, mt, mb);
+    // Issue 21's goal: >= 95 % of each lip, <= 0.5 % spill, edges within 1 px of their smoothed lines. The
+    // lipstick is drawn per pixel, masked by the lips' field (makeup.c, "Region masks per pixel": the
+    // splats' a* about their Otsu cut, over 3 mm) and fills it within the brush's reach (makeup_fine.glsl).
+    // The truth is the albedo's border (lips_truth), so lighting does not move it; against the lit
+    // picture's truth the same painted pixels had moved from 94.4 / 96.6 %, spill 5.6 % to 93.6 / 96.4 %,
+    // 9.7 % when the bounce light came. Measured now: 96.2 / 96.1 %, spill 0.36 %, wander 0.17 / 0.51 px
+    // (moving averages 0.69 / 2.03 px); the former field (a* +-12, cut at Otsu's, the region's border
+    // cutting the lower lip) measured 88.9 / 91.9 %, 0.38 %, wander against the moving average 0.67 / 1.66.
+    // lipstick_lips_3x_truth.png shows the border (green), lip left uncovered (blue), the mouth line no
+    // lipstick reaches (magenta, not counted) and spill (yellow).
+    RS_CHECK(cu >= 0.95 && cl >= 0.95,
+             "the lipstick covers %.1f %% of the upper lip, %.1f %% of the lower (goal >= 95 each)", 100 * cu, 100 * cl);
+    RS_CHECK(sp <= 0.005, "the lipstick spills onto %.2f %% of the lips' area of skin (goal <= 0.5 %%)", 100 * sp);
+    RS_CHECK(wt <= 1.0 && wb <= 1.0, "the lipstick's edges wander %.2f / %.2f px from their smoothed lines (goal <= 1)",
+             wt, wb);
     free(top), free(bottom), free(d), free(full), free(mid[1]), free(mid[2]), free(lip), free(mouth);
     free(bare), free(paint);
     rouge_face_clear(face, &e);
-    if (!goal && held)
-        rs_test_skip("issue 21's goal not met yet: covers %.1f / %.1f %% of the lips (goal 95), spill %.2f %% "
-                     "(0.5), edges %.2f / %.2f px (1)", 100 * cu, 100 * cl, 100 * sp, wt, wb);
 }
 
 // A highlighter stroke along the cheekbone at 3x: a lift of the painted area, and no isolated specks
@@ -549,7 +599,9 @@ static void test_highlighter_is_a_sheen_without_specks(void)
     rouge_error e = {0};
     const int w = 640, h = 480;
     rouge_face_clear(face, &e);
-    rouge_view v = {.width = w, .height = h, .zoom = 3.0f, .yaw_deg = -30.0f, .pan = {0.45f, 0.2f}};
+    // The sheen and its glints are per pixel (composite.frag.glsl flakes()); the skin's finest LOD level is
+    // not what is looked at here, and drawing 250k of the 600k splats halves the check's time.
+    rouge_view v = {.width = w, .height = h, .zoom = 3.0f, .yaw_deg = -30.0f, .pan = {0.45f, 0.2f}, .max_splats = 250000};
     rouge_face_set_view(face, &v, &e);
     uint8_t *bare = NULL, *paint = NULL;
     RS_REQUIRE(render(w, h, &bare), "render");

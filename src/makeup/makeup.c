@@ -709,6 +709,12 @@ static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
         return rs_fail(err, RS_ERR_NOMEM, "makeup: lips mask: out of memory");
     }
     memcpy(fs, p, (size_t)mk->n * sizeof *fs);
+    float *p0 = malloc(RS_MAX(mk->n, 1u) * sizeof *p0);  // the region itself, 0 / 1
+    if (!p0) {
+        free(a), free(p), free(fs);
+        return rs_fail(err, RS_ERR_NOMEM, "makeup: lips mask: out of memory");
+    }
+    memcpy(p0, p, (size_t)mk->n * sizeof *p0);
     if (total >= 64 && cut >= 0 && (m1 - m0) / per_bin >= 4.0) {
         float t = lo + (float)((m0 + 0.3 * (m1 - m0)) / per_bin), band = (float)((m1 - m0) / per_bin) * 0.2f;
         float cut_a = lo + (float)(cut + 1) / per_bin;
@@ -718,7 +724,32 @@ static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
             p[i] = x * x * (3.0f - 2.0f * x);
             fs[i] = RS_CLAMP((a[i] - cut_a - RS_MAKEUP_LIP_CUT_SHIFT) / (2.0f * RS_MAKEUP_LIP_A_SPAN) + 0.5f, 0.0f, 1.0f);
         }
+        // The region's border is ragged at the splats' scale and may cut across the vermilion (the lower
+        // lip's): splats outside it but within RS_MAKEUP_LIP_REACH_MM of it give the field their colour
+        // too, so the colour, not the region, draws the line there. (Near: a field of the region itself
+        // over that radius is above 0 at the splat.)
+        const rs_splat_header *hn = &mk->cloud->hdr;
+        float rn = RS_MAKEUP_LIP_REACH_MM / (hn->mm_per_unit > 0.0f ? hn->mm_per_unit : 1.0f);
+        if (rn > 0.0f) {
+            rs_result rr = build_field(mk, RS_COSMETIC_REGION_LIPS, p0, rn, 0.0f, 1.0f, err);
+            if (rr != RS_OK) {
+                free(a), free(p), free(fs), free(p0);
+                return rr;
+            }
+            rs_makeup_field nf = mk->field[RS_COSMETIC_REGION_LIPS];
+            mk->field[RS_COSMETIC_REGION_LIPS] = (rs_makeup_field){0};
+            for (uint32_t i = 0; nf.value && i < mk->n; i++) {
+                if (w[i] || rs_makeup_field_weight(&nf, mk->cloud->pos[i]) <= 0.5f) continue;
+                uint32_t c = mk->cloud->packed[i].w[3];
+                uint8_t rgb[3] = {(uint8_t)c, (uint8_t)(c >> 8), (uint8_t)(c >> 16)};
+                double lab[3];
+                rs_srgb8_to_lab(rgb, lab);
+                fs[i] = RS_CLAMP(((float)lab[1] - cut_a - RS_MAKEUP_LIP_CUT_SHIFT) / (2.0f * RS_MAKEUP_LIP_A_SPAN) + 0.5f, 0.0f, 1.0f);
+            }
+            free(nf.value);
+        }
     }
+    free(p0);
     const rs_splat_header *h = &mk->cloud->hdr;
     float r = RS_MAKEUP_LIP_SMOOTH_MM / (h->mm_per_unit > 0.0f ? h->mm_per_unit : 1.0f), r2 = r * r;
     int reach = RS_CLAMP((int)ceilf(r * mk->inv_cell), 1, 4);
@@ -754,13 +785,14 @@ static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
     for (uint32_t i = 0; i < mk->n; i++)
         if (w[i]) w[i] = (uint8_t)lrintf(255.0f * a[i]);
     free(a);
-    // The field: the lip colour (or the region) averaged over RS_MAKEUP_LIP_FIELD_MM (sigma 1.5 mm); its
-    // level at the cut is the lip line. Measured at the lips' 3x close-up against the border the albedo
-    // shows (test_fine_makeup): over 3 mm the line follows the colour's wobble (edges wander 0.67 / 1.66 px,
-    // covers 88.9 / 91.9 % of the lips, spill 0.4 %; 1.5 mm: 0.96 / 2.70 px); over 4.5 mm it is one smooth
-    // curve (0.61 / 1.13 px), pulled into the lips' convex outline by the blur, which the cut, lowered by
-    // RS_MAKEUP_LIP_CUT_SHIFT, gives back (91.7 / 94.1 %, spill 3.0 %; at -4 93.9 / 97.1 %, 8.9 %; at 6 mm and
-    // -3 92.3 / 94.0 %, 5.2 %, 0.59 / 0.98 px).
+    // The field: the lip colour (or the region) averaged over RS_MAKEUP_LIP_FIELD_MM (sigma 1 mm); its level
+    // at the cut is the lip line. Measured at the lips' 3x close-up against the border the scan's albedo
+    // shows (test_fine_makeup), covered / spill / wander: a* mapped over +-12 about Otsu's cut, the region's
+    // border cutting the lower lip, 88.9 / 91.9 %, 0.4 %; the colour beyond that border (REACH) and a* over
+    // +-4 (RS_MAKEUP_LIP_A_SPAN: nearer a step, so the blur's 0.5 level sits at the colour change, not
+    // pulled into the lips' round outline) 94.6 / 94.9 %, 0.14 %; the cut 0.25 a* lower 96.2 / 96.1 %,
+    // 0.36 %. Over 2 mm the line follows the colour's blotches (the lower lip's edge dents); over 4.5 or
+    // 6 mm it is smoother still but the cut must drop 0.5-1 a* to fill the corners, and spills 0.9-1.5 %.
     float fr = RS_MAKEUP_LIP_FIELD_MM / (h->mm_per_unit > 0.0f ? h->mm_per_unit : 1.0f);
     rs_result res = build_field(mk, RS_COSMETIC_REGION_LIPS, fs, fr, 0.5f, RS_MAKEUP_LIP_LINE_BAND, err);
     free(p), free(fs);

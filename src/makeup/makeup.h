@@ -69,10 +69,11 @@ typedef enum rs_makeup_pressure {
 #define RS_MAKEUP_LIP_SMOOTH_MM 3.0f // the lips mask: lip colour averaged over this radius (makeup.c)
 #define RS_MAKEUP_FINE_RADIUS_MM 4.0f // brushes narrower than this are the fine layer: evaluated per pixel
 #define RS_MAKEUP_FIELD_VOXEL_MM 0.4f // region fields (rs_makeup_field): voxel edge, at least
-#define RS_MAKEUP_LIP_A_SPAN 12.0f    // the lips' field: CIELAB a* within this of the lip/skin cut (makeup.c)
-#define RS_MAKEUP_LIP_FIELD_MM 4.5f   // the lips' field: lip colour averaged over this radius (makeup.c)
-#define RS_MAKEUP_LIP_CUT_SHIFT -2.0f // the lips' field: its cut, CIELAB a* from Otsu's (makeup.c)
-#define RS_MAKEUP_LIP_LINE_BAND 0.1f  // the lipstick's edge: the field's rise over it (a* +-1.2 about the cut)
+#define RS_MAKEUP_LIP_A_SPAN 4.0f     // the lips' field: CIELAB a* within this of the lip/skin cut (makeup.c)
+#define RS_MAKEUP_LIP_FIELD_MM 3.0f   // the lips' field: lip colour averaged over this radius (makeup.c)
+#define RS_MAKEUP_LIP_CUT_SHIFT -0.25f // the lips' field: its cut, CIELAB a* from Otsu's (makeup.c)
+#define RS_MAKEUP_LIP_REACH_MM 1.5f   // the lips' field: splats this near the region give their colour (makeup.c)
+#define RS_MAKEUP_LIP_LINE_BAND 0.1f  // the lipstick's edge: the field's rise over it (a* +-0.4 about the cut)
 
 typedef struct rs_makeup_desc {
     uint32_t undo_levels;  // strokes kept for undo/redo; 0 = 64
