@@ -905,9 +905,10 @@ static void check_look_on_lods(bool masked)
              masked ? " (kept to regions)" : "", 100 * m.frac_over, m.max_abs, m.psnr);
         // Kept to regions, the lipstick's edge is a crisp line (the lips' field, drawn per pixel) that the
         // coarser LOD's field places up to a pixel away: those few edge pixels change by the lipstick's
-        // full contrast, so the bound is on how many there are.
+        // full contrast (deepened by the satin's own wet coat, makeup_fine.glsl rs_fine_wet: 49 measured),
+        // so the bound is on how many there are.
         double max_frac = masked ? 0.003 : 0.001;
-        int max_abs = masked ? 48 : 8;
+        int max_abs = masked ? 56 : 8;
         if (!RS_CHECK(m.frac_over <= max_frac && m.max_abs <= max_abs,
                       "look on the %u-splat LOD%s: %.3f%% of pixels differ by > 3 levels (allowed %.1f%%), max %d "
                       "(allowed %d)",
