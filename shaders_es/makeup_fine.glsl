@@ -97,7 +97,7 @@ void rs_fine_stack(inout rs_fine_layer l, float a, int p, bool eraser, inout flo
 // film's upper face (1 - F(theta_v)), radiance / n^2; what is beyond the critical angle (r_i = 1 - (1 -
 // r_e) / n^2 = 0.596) is reflected back down and scattered again, and absorbed by the pigment each time:
 //   a_wet / a = (1 - F(theta_v)) (1 - r_e) / (n^2 (1 - a r_i)),
-// about 0.96 for a white, 0.43 for a dark pigment: the wet colour is deeper and more saturated. A gloss
+// 0.96 for a white, 0.39 for a black: the wet colour is deeper and more saturated. A gloss
 // over lipstick does not wet all of it so: where the product's wax already holds its pigment at the same
 // index the film adds no new interface; only the porous, air-filled top of a (satin or matte) film fills
 // with the oil. RS_COAT_WETTING is that share (chosen, not measured). The coat's reflection is the

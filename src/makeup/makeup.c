@@ -658,6 +658,13 @@ static rs_result build_field(rs_makeup *mk, rs_cosmetic_region region, const flo
     return RS_OK;
 }
 
+// The lips field's source at a splat of CIELAB a* `a` (cut_a: Otsu's lip/skin cut): 0..1 over
+// RS_MAKEUP_LIP_A_SPAN about the cut (lowered by RS_MAKEUP_LIP_CUT_SHIFT).
+static float lip_source(float a, float cut_a)
+{
+    return RS_CLAMP((a - cut_a - RS_MAKEUP_LIP_CUT_SHIFT) / (2.0f * RS_MAKEUP_LIP_A_SPAN) + 0.5f, 0.0f, 1.0f);
+}
+
 // The lips' mask. The converter's lips region is a blob around the mouth (an ellipse in the face frame,
 // ragged at splat scale: spikes of 1-2 mm): it reaches over the upper lip's border onto the skin, and a
 // mask that fades in from its border keeps the spikes. Two things make the mask follow the lip line:
@@ -722,7 +729,7 @@ static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
             if (!w[i]) continue;
             float x = RS_CLAMP((a[i] - (t - band)) / (2.0f * band), 0.0f, 1.0f);
             p[i] = x * x * (3.0f - 2.0f * x);
-            fs[i] = RS_CLAMP((a[i] - cut_a - RS_MAKEUP_LIP_CUT_SHIFT) / (2.0f * RS_MAKEUP_LIP_A_SPAN) + 0.5f, 0.0f, 1.0f);
+            fs[i] = lip_source(a[i], cut_a);
         }
         // The region's border is ragged at the splats' scale and may cut across the vermilion (the lower
         // lip's): splats outside it but within RS_MAKEUP_LIP_REACH_MM of it give the field their colour
@@ -744,7 +751,7 @@ static rs_result lips_mask(rs_makeup *mk, uint8_t *w, rs_error *err)
                 uint8_t rgb[3] = {(uint8_t)c, (uint8_t)(c >> 8), (uint8_t)(c >> 16)};
                 double lab[3];
                 rs_srgb8_to_lab(rgb, lab);
-                fs[i] = RS_CLAMP(((float)lab[1] - cut_a - RS_MAKEUP_LIP_CUT_SHIFT) / (2.0f * RS_MAKEUP_LIP_A_SPAN) + 0.5f, 0.0f, 1.0f);
+                fs[i] = lip_source((float)lab[1], cut_a);
             }
             free(nf.value);
         }
