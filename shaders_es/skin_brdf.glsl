@@ -1,6 +1,7 @@
 // skin_brdf.glsl — the Kelemen/Szirmay-Kalos specular BRDF as GPU Gems 3 ch. 14 uses it (METHOD.md):
 // Beckmann P_H without the 1/pi (so Weyrich et al.'s rho_s keep their meaning), Schlick Fresnel with
 // F0 = 0.028 (skin, n = 1.4), S = (N.L) rho_s max(P_H F / dot(h, h), 0) with h = L + V unnormalised.
+// rho_s 1 is the physical lobe; the composite divides Weyrich's rho_s by their mean (RS_RHO_S_PHYSICAL).
 // The same lobe with rho_s 1 and F0 0.04 is the clear coat of a gloss (docs/makeup.md).
 #define RS_F0_SKIN 0.028
 #define RS_F0_COAT 0.04

@@ -40,7 +40,7 @@ static const float band_lo[BANDS] = {0.8f, 0.6f, 0.4f, 0.25f, 0.12f};
 static const float band_hi[BANDS] = {1.0f, 0.8f, 0.6f, 0.4f, 0.25f};
 
 // A white sphere of radius SPHERE_MM (Fibonacci points about 0.62 mm apart, the head's spacing), one
-// region with roughness m and rho_s 1.
+// region with roughness m and the rho_s whose lobe is the physical one.
 static rs_splat_cloud *make_sphere(float m)
 {
     int k = (int)(4.0f * 3.14159f * SPHERE_MM * SPHERE_MM / (0.62f * 0.62f));
@@ -56,7 +56,7 @@ static rs_splat_cloud *make_sphere(float m)
     rs_splat_header h = {.mm_per_unit = MM_PER_UNIT, .forward = {0, 0, 1}, .up = {0, 1, 0},
                          .face_height = 2.0f * SPHERE_MM / MM_PER_UNIT, .region_count = RS_REGION_BUILTIN_COUNT};
     rs_splat_default_regions(&h);
-    for (int r = 0; r < RS_REGION_BUILTIN_COUNT; r++) h.regions[r].m = m, h.regions[r].rho_s = 1.0f;
+    for (int r = 0; r < RS_REGION_BUILTIN_COUNT; r++) h.regions[r].m = m, h.regions[r].rho_s = RS_RHO_S_PHYSICAL;
     rs_splat_cloud *c = NULL;
     rs_error err = {0};
     if (rs_splat_create(s, (uint32_t)k, &h, &c, &err) != RS_OK) printf("# sphere: %s\n", err.msg);
