@@ -47,16 +47,19 @@ typedef struct measured {
     double delta_e, ratio[R_COUNT], band;
 } measured;
 static const measured was[] = {
-    // Measured with skin's specular at the physical strength (RS_RHO_S_PHYSICAL). Studio front's band keeps
-    // the value from before it (0.863): its 1.32 is the side lamp's grazing streak, not a goal met.
-    {"studio", "front", 2.36, {1.143, 1.049, 0.994, 0.997, 1.031}, 0.863},
-    {"studio", "threequarter", 2.83, {1.195, 1.083, 0.883, 1.063, 1.016}, 0.874},
-    {"daylight", "front", 2.03, {1.072, 0.995, 1.053, 1.028, 1.096}, 0.878},
-    {"daylight", "threequarter", 1.91, {1.080, 1.006, 0.977, 1.013, 1.077}, 0.903},
-    {"office", "front", 2.61, {1.117, 0.981, 1.054, 0.890, 1.125}, 0.995},
-    {"office", "threequarter", 2.24, {1.123, 1.015, 1.080, 1.005, 1.151}, 0.986},
-    {"sunset", "front", 2.30, {1.155, 1.093, 1.105, 1.068, 1.194}, 0.877},
-    {"sunset", "threequarter", 2.25, {1.150, 1.108, 1.007, 1.060, 1.164}, 0.888},
+    // Measured with skin's specular at the physical strength (RS_RHO_S_PHYSICAL), Smith's masking-shadowing
+    // in the lobe and the environment's reflection blocked by the head itself (composite.frag.glsl). Studio
+    // front's band keeps the value from before the physical strength (0.876): its 1.156 is the side lamp's
+    // grazing sheen on the temple, not a goal met. Studio 3/4's ears (0.825, 0.923 before the physical
+    // strength) are outside the goal's range: rouge's ear is brighter than the path tracer's (issue 22).
+    {"studio", "front", 2.07, {1.102, 1.037, 0.984, 1.055, 0.978}, 0.876},
+    {"studio", "threequarter", 2.53, {1.116, 1.085, 0.825, 1.039, 0.974}, 0.893},
+    {"daylight", "front", 1.81, {1.008, 0.988, 0.991, 1.021, 1.002}, 0.886},
+    {"daylight", "threequarter", 1.58, {0.972, 1.008, 0.892, 0.990, 0.991}, 0.917},
+    {"office", "front", 2.10, {1.055, 0.974, 1.003, 0.964, 1.014}, 0.975},
+    {"office", "threequarter", 1.71, {1.058, 1.036, 1.015, 1.005, 1.047}, 0.993},
+    {"sunset", "front", 1.97, {1.107, 1.078, 1.040, 1.066, 1.113}, 0.886},
+    {"sunset", "threequarter", 1.70, {1.077, 1.103, 0.938, 1.028, 1.100}, 0.910},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
