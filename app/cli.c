@@ -43,7 +43,7 @@ static const opt opts[] = {
     {"--exposure", OPT_FLOAT, "X", "linear exposure before the filmic curve and sRGB (default 1)", 0.01f, 100},
     {"--background", OPT_RGB, "R,G,B", "background colour, sRGB 0..1", 0, 1},
     {"--no-shadows", OPT_FLAG, NULL, "disable the shadow map", 0, 0},
-    {"--specular-scale", OPT_FLOAT, "X", "multiply every rho_s (1 = Weyrich's measured skin; 2 = oily skin)", 0.01f, 10},
+    {"--specular-scale", OPT_FLOAT, "X", "multiply every rho_s (1 = measured skin, physical strength; 2 = oily)", 0.01f, 10},
     {"--ambient", OPT_FLOAT, "X", "uniform sky light added to the irradiance (--env paper; default 0.05)", 0, 10},
     {"--max-splats", OPT_INT, "N", "draw at most N splats (an LOD prefix)", 1, 2e9f},
     {"--kernels", OPT_INT, "K", "mobile pipeline: number of Gaussians (2..4, default 3)", 2, 4},

@@ -111,8 +111,12 @@ out:
 // reflection at a contour drew a 1-px line as bright as a highlight along the nostril rims: the mirror
 // direction there runs into the lip just behind, not into the sky. In the `specular` view, the nose's
 // edge-on pixels that face down (over the lip) may be no brighter than the nose's own highlight (the
-// brightest pixel facing the eye; before: 148 against 45), while its edge-on pixels that face sideways,
-// with nothing close behind, keep their grazing sheen (brighter than 19 in 20 of the facing pixels).
+// brightest pixel facing the eye; before: 148 against 45). Its edge-on pixels that face sideways mirror
+// the cheek beside and behind them, not the studio's side lamps: the path tracer shows no sheen there
+// (tests/test_truth.c), and with the skin's physical specular strength a white streak ran down the nose's
+// side until the head blocked its own reflections (composite.frag.glsl reflection_open): their p90 stays
+// at or below the facing pixels' p95, while the facing pixels keep their sheen (p95 >= 20: not every
+// reflection blocked).
 static void check_rim(rouge_pipeline pipeline, const char *name)
 {
     size_t n = (size_t)SIZE * SIZE * 4;
@@ -141,8 +145,9 @@ static void check_rim(rouge_pipeline pipeline, const char *name)
            name, under_max, nu, highlight, side_p90, facing_p95);
     RS_CHECK(under_max <= highlight, "%s: the rim under the nose (%d) outshines the nose's highlight (%d)", name,
              under_max, highlight);
-    RS_CHECK(side_p90 > facing_p95, "%s: the nose's sides lost their grazing sheen (p90 %d, facing p95 %d)", name,
-             side_p90, facing_p95);
+    RS_CHECK(side_p90 <= facing_p95, "%s: a streak down the nose's sides (p90 %d, facing p95 %d)", name, side_p90,
+             facing_p95);
+    RS_CHECK(facing_p95 >= 20, "%s: the nose lost its sheen where it faces the eye (p95 %d)", name, facing_p95);
 out:
     free(spec), free(normals), free(regions), free(under), free(side), free(facing);
 }

@@ -40,7 +40,7 @@ static const float band_lo[BANDS] = {0.8f, 0.6f, 0.4f, 0.25f, 0.12f};
 static const float band_hi[BANDS] = {1.0f, 0.8f, 0.6f, 0.4f, 0.25f};
 
 // A white sphere of radius SPHERE_MM (Fibonacci points about 0.62 mm apart, the head's spacing), one
-// region with roughness m and rho_s 1.
+// region with roughness m and the rho_s whose lobe is the physical one.
 static rs_splat_cloud *make_sphere(float m)
 {
     int k = (int)(4.0f * 3.14159f * SPHERE_MM * SPHERE_MM / (0.62f * 0.62f));
@@ -56,7 +56,7 @@ static rs_splat_cloud *make_sphere(float m)
     rs_splat_header h = {.mm_per_unit = MM_PER_UNIT, .forward = {0, 0, 1}, .up = {0, 1, 0},
                          .face_height = 2.0f * SPHERE_MM / MM_PER_UNIT, .region_count = RS_REGION_BUILTIN_COUNT};
     rs_splat_default_regions(&h);
-    for (int r = 0; r < RS_REGION_BUILTIN_COUNT; r++) h.regions[r].m = m, h.regions[r].rho_s = 1.0f;
+    for (int r = 0; r < RS_REGION_BUILTIN_COUNT; r++) h.regions[r].m = m, h.regions[r].rho_s = RS_RHO_S_PHYSICAL;
     rs_splat_cloud *c = NULL;
     rs_error err = {0};
     if (rs_splat_create(s, (uint32_t)k, &h, &c, &err) != RS_OK) printf("# sphere: %s\n", err.msg);
@@ -101,10 +101,16 @@ static bool turned_source(const char *path, rs_envmap *out, rs_envmap *rest, flo
 
 static double dot3(const float *a, const float *b) { return (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2]; }
 
-// The lobe as skin_brdf.glsl's rs_ksk_lobe: (N.L) P_H F / |L + V|^2, Schlick F0.
+static double beckmann_lambda(double c, double m)
+{
+    double a = c / (m * sqrt(fmax(1 - c * c, 1e-8)));
+    return a >= 1.6 ? 0 : (1 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
+}
+
+// The lobe as skin_brdf.glsl's rs_ksk_lobe: P_H F G / (4 N.V), Schlick F0, Smith's height-correlated G.
 static double ksk(const float N[3], const float L[3], const float V[3], double m, double f0)
 {
-    double nl = dot3(N, L);
+    double nl = dot3(N, L), nv = fmax(dot3(N, V), 1e-3);
     if (nl <= 0) return 0;
     double h[3] = {L[0] + V[0], L[1] + V[1], L[2] + V[2]};
     double hh = h[0] * h[0] + h[1] * h[1] + h[2] * h[2];
@@ -116,7 +122,8 @@ static double ksk(const float N[3], const float L[3], const float V[3], double m
     double c2 = nh * nh, m2 = m * m;
     double ph = exp((c2 - 1) / (c2 * m2)) / (m2 * c2 * c2);
     double e = pow(1 - fmin(fmax(vh, 0), 1), 5);
-    return nl * ph * (e + f0 * (1 - e)) / hh;
+    double g = 1 / (1 + beckmann_lambda(nv, m) + beckmann_lambda(nl, m));
+    return ph * (e + f0 * (1 - e)) * g / (4 * nv);
 }
 
 // Exact reflected luminance: (1/pi) sum L(l) lobe(N, l, V) dw over the whole capture (every light in the

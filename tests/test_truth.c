@@ -35,25 +35,31 @@
 #define LABEL_CONTOUR 128
 #define REGION_NOSE 2
 #define REGION_LIPS 4
+#define REGION_FOREHEAD 3
 #define REGION_EYELID 5
 
 enum { R_CHIN, R_LIPS, R_EARS, R_NOSE, R_EYES, R_COUNT };
 static const char *region_names[R_COUNT] = {"under chin", "lips", "ears", "nose", "eye sockets"};
 
-// What was measured when the fixtures were made (rouge as of this test's commit): the regression guards.
+// What rouge measured last (the regression guards; updated when a change improves them).
 typedef struct measured {
     const char *env, *view;
     double delta_e, ratio[R_COUNT], band;
 } measured;
 static const measured was[] = {
-    {"studio", "front", 2.31, {1.130, 1.072, 1.067, 1.057, 1.038}, 0.751},
-    {"studio", "threequarter", 3.35, {1.194, 1.101, 1.069, 1.055, 1.028}, 0.825},
-    {"daylight", "front", 2.11, {1.073, 1.038, 1.056, 1.041, 1.094}, 0.856},
-    {"daylight", "threequarter", 2.06, {1.078, 1.052, 0.979, 1.042, 1.063}, 0.872},
-    {"office", "front", 2.95, {1.090, 0.999, 1.094, 0.954, 1.119}, 0.802},
-    {"office", "threequarter", 2.51, {1.087, 1.029, 1.109, 1.011, 1.118}, 0.836},
-    {"sunset", "front", 2.40, {1.132, 1.107, 1.105, 1.073, 1.189}, 0.837},
-    {"sunset", "threequarter", 2.31, {1.124, 1.143, 1.005, 1.073, 1.169}, 0.848},
+    // Measured with skin's specular at the physical strength (RS_RHO_S_PHYSICAL), Smith's masking-shadowing
+    // in the lobe and the environment's reflection blocked by the head itself (composite.frag.glsl). Studio
+    // front's band keeps the value from before the physical strength (0.876): its 1.156 is the side lamp's
+    // grazing sheen on the temple, not a goal met. Studio 3/4's ears (0.825, 0.923 before the physical
+    // strength) are outside the goal's range: rouge's ear is brighter than the path tracer's (issue 22).
+    {"studio", "front", 2.07, {1.102, 1.037, 0.984, 1.055, 0.978}, 0.876},
+    {"studio", "threequarter", 2.53, {1.116, 1.085, 0.825, 1.039, 0.974}, 0.893},
+    {"daylight", "front", 1.81, {1.008, 0.988, 0.991, 1.021, 1.002}, 0.886},
+    {"daylight", "threequarter", 1.58, {0.972, 1.008, 0.892, 0.990, 0.991}, 0.917},
+    {"office", "front", 2.10, {1.055, 0.974, 1.003, 0.964, 1.014}, 0.975},
+    {"office", "threequarter", 1.71, {1.058, 1.036, 1.015, 1.005, 1.047}, 0.993},
+    {"sunset", "front", 1.97, {1.107, 1.078, 1.040, 1.066, 1.113}, 0.886},
+    {"sunset", "threequarter", 1.70, {1.077, 1.103, 0.938, 1.028, 1.100}, 0.910},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
@@ -226,6 +232,7 @@ static void heat(double de, uint8_t *p)
 
 typedef struct result {
     double k, iou, albedo_diff, delta_e, ratio[R_COUNT], band;
+    double forehead, highlights;  // path tracer / rouge: specular-dominated areas (diagnostics, not goals)
     int region_px[R_COUNT], band_px;
 } result;
 
@@ -339,6 +346,26 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
         }
     }
     for (int r = 0; r < R_COUNT; r++) res->ratio[r] = reg[r][1] > 0 ? reg[r][0] / reg[r][1] : 0.0;
+    // Where the specular shows (the fixtures have no specular pass): the forehead, and the highlights, the
+    // 3 % of face pixels brightest in the path tracer relative to their albedo (the lit rim, the nose's ridge).
+    double fh[2] = {0}, hl[2] = {0};
+    size_t shade_n = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!mask[i]) continue;
+        double a[3] = {t->albedo[i * 3], t->albedo[i * 3 + 1], t->albedo[i * 3 + 2]};
+        ratio[shade_n++] = lum(pt + i * 3) / fmax(lum(a), 1e-3);
+        if ((t->label[i] & (LABEL_CONTOUR - 1)) == LABEL_REGION0 + REGION_FOREHEAD)
+            fh[0] += lum(pt + i * 3), fh[1] += lum(ro + i * 3);
+    }
+    qsort(ratio, shade_n, sizeof *ratio, cmp_double);
+    double shade_hi = ratio[shade_n - 1 - shade_n * 3 / 100];
+    for (size_t i = 0; i < n; i++) {
+        if (!mask[i]) continue;
+        double a[3] = {t->albedo[i * 3], t->albedo[i * 3 + 1], t->albedo[i * 3 + 2]};
+        if (lum(pt + i * 3) / fmax(lum(a), 1e-3) >= shade_hi) hl[0] += lum(pt + i * 3), hl[1] += lum(ro + i * 3);
+    }
+    res->forehead = fh[1] > 0 ? fh[0] / fh[1] : 0.0;
+    res->highlights = hl[1] > 0 ? hl[0] / hl[1] : 0.0;
     res->band = band[1] > 0 ? band[0] / band[1] : 0.0;
     // rouge | path tracer | dE (both over black).
     rs_image side = {0};
@@ -379,7 +406,8 @@ static void test_view(void)
            ref->env, ref->view, r.k, r.iou, r.albedo_diff, r.delta_e);
     for (int i = 0; i < R_COUNT; i++)
         if (r.region_px[i] >= 20) printf(" %s %.3f", region_names[i], r.ratio[i]);
-    printf("; contour band rouge / path tracer %.3f (%d px)\n", r.band, r.band_px);
+    printf("; contour band rouge / path tracer %.3f (%d px); specular areas, path tracer / rouge: forehead %.3f"
+           " highlights %.3f\n", r.band, r.band_px, r.forehead, r.highlights);
     // The fixture is the scene rouge renders: same camera and outline, same albedo.
     RS_CHECK(r.iou >= 0.98, "silhouettes differ: IoU %.4f", r.iou);
     // albedo_diff -1: not checked under this environment.

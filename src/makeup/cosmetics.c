@@ -69,8 +69,9 @@ static const rs_cosmetic presets[] = {
     {"eyeshadow_champagne", RS_COSMETIC_EYESHADOW, {222, 192, 152}, 0.55f, 0.80f, 1.00f, 0.22f, 0.40f, 0.07f, 0.60f,
      0.0f, 0.60f, 0.0f, RS_COSMETIC_REGION_EYES},
     // Eyeliner: near-black, opaque (coverage 1: its black is not lifted to the face's darkest colour),
-    // fine hard line; a matte gel liner (a glossy one mirrors the softboxes as a grey streak along it).
-    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.38f, 0.10f, 0.02f, 1.00f,
+    // fine hard line; a matte gel liner, rho_s a sixth of skin's (a glossier one mirrors the softboxes
+    // as a grey streak along it).
+    {"eyeliner", RS_COSMETIC_EYELINER, {28, 22, 22}, 0.90f, 1.00f, 1.00f, 0.38f, 0.045f, 0.02f, 1.00f,
      0.0f, 0.0f, 1.00f, RS_COSMETIC_REGION_EYES},
     // Brow pencil: taupe brown, fine (a 2 mm tip: hair-like strokes along the brow), semi-opaque, matte.
     // Any region: the brows are their own region in a scan, or none.

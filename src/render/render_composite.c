@@ -48,7 +48,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
         bg[c] = v->linear_output ? rs_srgb_to_linear(b) : b;
     }
     glUniform3fv(rs_uloc(prog, "u_background"), 1, bg);
-    glUniform1f(rs_uloc(prog, "u_rho_s_scale"), v->rho_s_scale);
+    glUniform1f(rs_uloc(prog, "u_rho_s_scale"), v->rho_s_scale / RS_RHO_S_PHYSICAL);  // relative to physical
     glUniform1f(rs_uloc(prog, "u_diffuse_scale"), r->float_rt ? 1.0f : 1.0f / RS_DIFFUSE_SCALE_RGBA8);
     glUniform3fv(rs_uloc(prog, "u_delta_weight"), 1, f->delta_weight);
     glUniform3fv(rs_uloc(prog, "u_key_dir"), 1, f->key_dir);

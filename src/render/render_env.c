@@ -19,11 +19,19 @@
 // camera lit from 0.48 (office) to 0.71 (studio); now the face's picture gets the same light in each.
 #define ENV_TARGET_FRONT 0.53f
 
-// Directional albedo of the lobe S = (N.L) P_H F / |L + V|^2 (rho_s 1) over the hemisphere, divided by pi
-// as every light in the renderer is (a white Lambertian surface under irradiance E reflects E): F0 A + B.
-// Importance-sampled with Beckmann half vectors: with pdf(L) = P_H (N.H) / (4 pi V.H) and |L + V|^2 =
-// 4 (V.H)^2, each sample weighs (N.L) F / ((V.H) (N.H)). Hammersley points: the table is the same on every
-// machine.
+// Smith's Lambda for Beckmann roughness m at cos(theta) = c (skin_brdf.glsl's rs_beckmann_lambda).
+static float beckmann_lambda(float c, float m)
+{
+    float a = c / (m * sqrtf(RS_MAX(1.0f - c * c, 1e-8f)));  // 1 / (m tan(theta))
+    if (a >= 1.6f) return 0.0f;
+    return (1.0f - 1.259f * a + 0.396f * a * a) / (3.535f * a + 2.181f * a * a);
+}
+
+// Directional albedo of the lobe S = P_H F G / (4 N.V) (rho_s 1; skin_brdf.glsl: the microfacet lobe with
+// Smith's height-correlated masking-shadowing for Beckmann) over the hemisphere, divided by pi as every
+// light in the renderer is (a white Lambertian surface under irradiance E reflects E): F0 A + B.
+// Importance-sampled with Beckmann half vectors: with pdf(L) = P_H (N.H) / (4 pi V.H), each sample weighs
+// F G (V.H) / ((N.V) (N.H)). Hammersley points: the table is the same on every machine.
 static void lobe_albedo(float ndotv, float m, float *a, float *b)
 {
     float V[3] = {sqrtf(RS_MAX(1.0f - ndotv * ndotv, 0.0f)), 0.0f, ndotv};
@@ -47,7 +55,8 @@ static void lobe_albedo(float ndotv, float m, float *a, float *b)
         float L[3] = {2.0f * vh * H[0] - V[0], 2.0f * vh * H[1] - V[1], 2.0f * vh * H[2] - V[2]};
         float nl = L[2];
         if (nl <= 0.0f) continue;
-        float w = nl / (vh * ch);
+        float g = 1.0f / (1.0f + beckmann_lambda(ndotv, m) + beckmann_lambda(nl, m));
+        float w = g * vh / (ndotv * ch);
         float e = powf(1.0f - vh, 5.0f);
         sa += w * (1.0f - e);
         sb += w * e;

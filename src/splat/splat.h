@@ -58,8 +58,15 @@ typedef struct rs_splat_packed {
 typedef struct rs_region_info {
     char name[16];     // "cheek", NUL-terminated
     float m;           // Beckmann roughness
-    float rho_s;       // specular scale (Kelemen/Szirmay-Kalos, GPU Gems 3 convention)
+    float rho_s;       // specular scale, Weyrich et al.'s relative units (RS_RHO_S_PHYSICAL)
 } rs_region_info;
+
+// The rho_s whose Kelemen/Szirmay-Kalos lobe is the physical one (albedo F0 at normal incidence): the mean
+// of Weyrich et al. 2006's per-region values (the region table's "other"). Their rho_s are relative
+// strengths; taken as absolute GPU Gems 3 scales skin would reflect 0.7 % at normal incidence, a quarter of
+// Fresnel for n = 1.4. The composite divides every rho_s (regions, makeup finishes) by it; the path-traced
+// reference (tools/truth/) uses F0 0.028 x rho_s / rho_s(other) the same way.
+#define RS_RHO_S_PHYSICAL 0.2725f
 
 typedef struct rs_splat_header {
     uint32_t count;
