@@ -10,11 +10,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-// The wall views: the middle half (rows 128..383) of a 512x512 view at zoom 1.2 and fov 30, 8.2 px/mm: every
-// pixel the edge and the acne band read, at half the pixels. The same camera distance (zoom 2.4 with the
-// narrower fov below), so the same projection of the scene; the pan in view heights moves it the same 102 px.
+// The wall views: the middle quarter (rows 192..319) of a 512x512 view at zoom 1.2 and fov 30, 8.2 px/mm,
+// +-7.8 mm about the row the edge is read on: every column the edge and the acne band read, at a quarter of
+// the pixels. The same camera distance (zoom 4.8 with the narrower fov below), so the same projection of the
+// scene; the pan in view heights moves it the same 102 px.
 #define W 512
-#define H 256
+#define H 128
+#define FLOOR_Y 12.0f  // mm: the floor and wall run over y in [-FLOOR_Y, FLOOR_Y], past the view's +-7.8 mm
 #define MM_PER_UNIT 47.0f  // the bundled head's scale
 #define WALL_H 20.0f       // mm: the top row of wall splats sits here (plus 0.1 k, below)
 #define RADIUS 0.95f       // mm: the bundled head's median splat radius
@@ -32,8 +34,9 @@ static void add(rs_splat *s, size_t *n, float x, float y, float z, float nx, flo
 }
 
 // At the bundled head's scale (the shadow map is fitted to the cloud's bounding sphere, so its texels
-// follow the cloud's size: 0.29 mm on the head at 2048^2): a floor z = 0 over x, y in [-40, 40] mm
-// (normal +z) and a wall x = 0, z in [0, wall_h] (normal +x, towards the light); or a sphere of radius
+// follow the cloud's size: 0.29 mm on the head at 2048^2): a floor z = 0 over x in [-40, 40] mm, y in
+// [-FLOOR_Y, FLOOR_Y] (normal +z) and a wall x = 0, z in [0, wall_h] (normal +x, towards the light; the
+// light turns about y, so the wall's ends cast their shadows along y = +-FLOOR_Y, out of view); or a sphere of radius
 // 20 mm. Eight tiny splats at the head's bounding-box corners give the head's bounding sphere (292 mm).
 static rs_splat_cloud *make_scene(bool sphere, float wall_h)
 {
@@ -50,7 +53,7 @@ static rs_splat_cloud *make_scene(bool sphere, float wall_h)
         }
     } else {
         int m = (int)lroundf(wall_h / SPACING);
-        for (float y = -40; y <= 40; y += SPACING) {
+        for (float y = -FLOOR_Y; y <= FLOOR_Y; y += SPACING) {
             for (float x = -40; x <= 40; x += SPACING) add(s, &n, x, y, 0, 0, 0, 1, RADIUS);
             for (int k = 1; k <= m; k++) add(s, &n, 0, y, wall_h * (float)k / m, 1, 0, 0, RADIUS);
         }
