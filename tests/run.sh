@@ -27,7 +27,7 @@ for t in "$build"/tests/test_* tests/test_*.sh; do
 done
 # Programs whose slowest checks run as jobs of their own, beside the rest of the program (the harness's
 # "-SUB" leaves them out of it): PROGRAM=SUB,SUB... Only without a name filter.
-split="$build/tests/test_mobile=tolerance_at_512,under_environments"
+split="$build/tests/test_mobile=tolerance_at_256,under_environments"
 # jobs_of TEST: its jobs, TEST or TEST+ARG+ARG... (the arguments replace the name filter).
 jobs_of() {
     t=$1
