@@ -1221,9 +1221,15 @@ static rs_result run(vw_viewer *v, rs_error *err)
         if ((r = poll_loader(v, err))) return r;
         vw_script_step step = {0};
         if (v->have_script) {
+            int next0 = v->script.next, frames0 = v->script.frames_left;
             vw_script_run(&v->script, &v->queue, settled(v), v->load.running, vw_now(), &step);
             if (step.quit) v->quit = true;
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
+            // A script waiting (on its clock, a file, a load) with nothing to show draws no frame: the
+            // same picture again and again cost a core while it waited.
+            if (!busy && v->script.next == next0 && !frames0 && !step.screenshot && !step.state && !v->queue.count &&
+                !v->looks.export_pending)
+                continue;
         }
         frame(v, &step, err);
     }

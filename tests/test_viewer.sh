@@ -238,15 +238,18 @@ if selected viewer_bad_event_script_names_the_line; then
 fi
 
 # Four independent interactions share one launch (a launch costs ~5 CPU-s): a bad drop, the light and
-# camera reset, the Shift+digit zooms and the eyedropper, in that order. Each starts from the picture as
+# camera reset, the Shift+digit zooms and the eyedropper (whose colour, kept with Enter, is also the first
+# session of viewer_my_shades_persist_and_can_be_picked_again), in that order. Each starts from the picture as
 # it started: the drop must leave the face as it was, and 0 brings camera and light back (both checked).
-drop_sel=0 reset_sel=0 zoom_sel=0 eye_sel=0
+drop_sel=0 reset_sel=0 zoom_sel=0 eye_sel=0 shade_sel=0
 selected viewer_bad_dropped_file_keeps_the_face && drop_sel=1
 selected viewer_key_0_resets_camera_and_light && reset_sel=1
 selected viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek && zoom_sel=1
 selected viewer_eyedropper_takes_the_face_colour_into_the_editor && eye_sel=1
-if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
-    rm -f "$out"/z[0-4].txt "$out"/eye[01].txt
+selected viewer_my_shades_persist_and_can_be_picked_again && shade_sel=1
+if [ $((drop_sel + reset_sel + zoom_sel + eye_sel + shade_sel)) -gt 0 ]; then
+    rm -f "$out"/z[0-4].txt "$out"/eye[01].txt "$out"/sh[0-2].txt
+    rm -rf "$out/shade_looks"
     head -c 1000 "$face" >"$out/dropped.rsf"
     # A FIFO dropped too: opening it once blocked the loader, and then the viewer could not be quit.
     rm -f "$out/dropped.fifo" && mkfifo "$out/dropped.fifo"
@@ -305,7 +308,7 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
             echo "idle"
             echo "state $out/z4.txt"
         fi
-        if [ $eye_sel = 1 ]; then
+        if [ $eye_sel = 1 ] || [ $shade_sel = 1 ]; then
             # Issue 21: V in the product editor takes the colour under the pointer from the rendered face:
             # over the lips (zoomed to with Shift+2) the product turns lip red, whatever the preset was.
             echo "key shift+2"
@@ -316,11 +319,15 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
             echo "key v"
             echo "idle"
             echo "state $out/eye1.txt"
+            echo "key enter"     # keep it in "my shades" (this launch's library: $out/shade_looks)
+            echo "idle"
+            echo "state $out/sh0.txt"
         fi
         echo "quit"
     } >"$out/views.events"
-    view --events "$out/views.events" >"$out/views.log" 2>&1
+    view --looks "$out/shade_looks" --events "$out/views.events" >"$out/views.log" 2>&1
     rc=$?
+    views_rc=$rc
 fi
 if [ $drop_sel = 1 ]; then
     name=viewer_bad_dropped_file_keeps_the_face
@@ -719,19 +726,16 @@ if selected viewer_my_shades_persist_and_can_be_picked_again; then
     # Issue 21: a custom shade (here taken from the lips with the eyedropper) kept with Enter goes into
     # "my shades", a file beside the looks; the next session shows it in the editor's row, and a tap on it
     # (the row's first swatch at (422, 408) 24x28 on an 800x600 window) paints with it again.
+    # The first session is the shared launch above (its eyedropper, then Enter); this is the next one.
     name=viewer_my_shades_persist_and_can_be_picked_again
-    rm -rf "$out/shade_looks"
-    printf 'key shift+2\nkey c\nmove 300 320\nidle\nkey v\nkey enter\nidle\nstate %s\nquit\n' "$out/sh0.txt" >"$out/shade0.events"
     printf 'key c\nidle\nstate %s\nclick 434 422\nidle\nstate %s\nquit\n' "$out/sh1.txt" "$out/sh2.txt" >"$out/shade1.events"
-    "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade0.events" \
-        >"$out/shade0.log" 2>&1
-    rc0=$?
+    rc0=${views_rc:-1}
     "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade1.events" \
         >"$out/shade1.log" 2>&1
     rc1=$?
     sv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/sh$1.txt" 2>/dev/null; }
     if [ $rc0 -ne 0 ] || [ $rc1 -ne 0 ] || [ ! -f "$out/sh2.txt" ]; then
-        echo "FAIL - $name: exit $rc0/$rc1: $(tail -c 300 "$out/shade0.log" "$out/shade1.log")"
+        echo "FAIL - $name: exit $rc0/$rc1: $(tail -c 300 "$out/views.log" "$out/shade1.log")"
     elif [ "$(sv 0 shades)" != 1 ] || [ ! -s "$out/shade_looks/shades.txt" ]; then
         echo "FAIL - $name: Enter kept $(sv 0 shades) shades, file: $(head -c 200 "$out/shade_looks/shades.txt" 2>&1)"
     elif [ "$(sv 1 shades)" != 1 ]; then echo "FAIL - $name: the next session has $(sv 1 shades) shades"
