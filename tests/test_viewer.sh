@@ -325,7 +325,8 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel + shade_sel)) -gt 0 ]; then
         fi
         echo "quit"
     } >"$out/views.events"
-    view --looks "$out/shade_looks" --events "$out/views.events" >"$out/views.log" 2>&1
+    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" \
+        --events "$out/views.events" >"$out/views.log" 2>&1
     rc=$?
     views_rc=$rc
 fi
