@@ -1212,16 +1212,24 @@ static rs_result run(vw_viewer *v, rs_error *err)
 
     while (!v->quit && !glfwWindowShouldClose(v->win)) {
         // Sleep while nothing changes: a viewer at rest costs no CPU.
-        bool busy = v->load.running || v->load.building || interacting(v) || v->dirty_view || v->dirty_makeup || !v->rendered_full ||
-                    (v->toast[0] && vw_now() < v->toast_until + 0.1);
+        // A toast is still: it needs a frame when it goes, not a busy loop while it shows (an error's
+        // 10 s of spinning once cost a scripted session most of its CPU).
+        bool busy = v->load.running || v->load.building || interacting(v) || v->dirty_view || v->dirty_makeup || !v->rendered_full;
+        double toast_left = v->toast[0] ? v->toast_until + 0.1 - vw_now() : 0;
         if (busy) glfwPollEvents();
-        else glfwWaitEventsTimeout(v->have_script ? 0.01 : 0.5);
+        else glfwWaitEventsTimeout(v->have_script ? 0.01 : toast_left > 0 ? RS_MIN(toast_left, 0.5) : 0.5);
         if ((r = poll_loader(v, err))) return r;
         vw_script_step step = {0};
         if (v->have_script) {
+            int next0 = v->script.next, frames0 = v->script.frames_left;
             vw_script_run(&v->script, &v->queue, settled(v), v->load.running, vw_now(), &step);
             if (step.quit) v->quit = true;
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
+            // A script waiting (on its clock, a file, a load) with nothing to show draws no frame: the
+            // same picture again and again cost a core while it waited.
+            if (!busy && v->script.next == next0 && !frames0 && !step.screenshot && !step.state && !v->queue.count &&
+                !v->looks.export_pending)
+                continue;
         }
         frame(v, &step, err);
     }

@@ -108,8 +108,11 @@ bounded() {
     if [ "$asan_build" -gt 0 ]; then timeout 60 "$@"; else (ulimit -v 2000000 && exec timeout 60 "$@"); fi
 }
 
-render() {  # the smallest render that still loads the whole face and makes a GL context
-    "$rouge" render "$@" --size 32x32 --max-splats 2000
+# The smallest render that still loads the whole face and makes a GL context. The mobile pipeline: the
+# cases here test input handling, not the renderer, and its render costs ~0.5 CPU-s where the reference
+# pipeline's shaders cost ~3.5 (the six cases that render to the end made half of this script's CPU).
+render() {
+    "$rouge" render "$@" --size 32x32 --max-splats 2000 --pipeline mobile
 }
 
 # ---- .rsf: truncated at every section (tiny_v1.rsf: header 0..624, records 624..688, CRC 688..692) ----

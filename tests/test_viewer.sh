@@ -159,7 +159,7 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
         if ! head -1 "$out/rec.strokes" 2>/dev/null | grep -q "^rouge-strokes 1"; then
             echo "FAIL - $name: $out/rec.strokes missing or not a stroke file"
         elif ! timeout 120 "$rouge" render "$face" --strokes "$out/rec.strokes" --max-splats 100000 --pipeline mobile \
-            -o "$out/replayed.png" >"$out/replay.log" 2>&1; then
+            --size 320x240 -o "$out/replayed.png" >"$out/replay.log" 2>&1; then
             echo "FAIL - $name: replay failed: $(tail -c 300 "$out/replay.log")"
         else echo "ok - $name"; fi
     fi
@@ -171,23 +171,24 @@ if selected viewer_xdotool_stroke_changes_only_the_painted_area; then
         echo "skip - $name: xdotool not installed"
     else
         flag="$out/xdo_done.flag"
+        rm -f "$out/xdo_ready.txt"
         {
             echo "key i"
             shots xbefore
             echo "key p"
             echo "key 9"
             echo "key k"
+            echo "state $out/xdo_ready.txt"   # written in the frame that applied the keys above
             echo "wait-for $flag"
             shots xafter
             echo "quit"
         } >"$out/xdo.events"
         view --events "$out/xdo.events" >"$out/$name.log" 2>&1 &
         pid=$!
-        # Wait for the first screenshots (the face is loaded and idle), then stroke with the real X pointer.
+        # Wait until the script has taken paint mode and lipstick (its state file), then stroke with the
+        # real X pointer.
         i=0
-        while [ ! -f "$out/xbefore_mid.png" ] && [ $i -lt 1200 ] && kill -0 $pid 2>/dev/null; do sleep 0.1; i=$((i + 1)); done
-        # A little longer: the script's next commands (paint mode, lipstick) run in the next frames.
-        sleep 1
+        while [ ! -f "$out/xdo_ready.txt" ] && [ $i -lt 1200 ] && kill -0 $pid 2>/dev/null; do sleep 0.05; i=$((i + 1)); done
         xdotool mousemove 370 150 mousedown 1 >/dev/null 2>&1
         x=370
         while [ $x -lt 430 ]; do
@@ -237,15 +238,18 @@ if selected viewer_bad_event_script_names_the_line; then
 fi
 
 # Four independent interactions share one launch (a launch costs ~5 CPU-s): a bad drop, the light and
-# camera reset, the Shift+digit zooms and the eyedropper, in that order. Each starts from the picture as
+# camera reset, the Shift+digit zooms and the eyedropper (whose colour, kept with Enter, is also the first
+# session of viewer_my_shades_persist_and_can_be_picked_again), in that order. Each starts from the picture as
 # it started: the drop must leave the face as it was, and 0 brings camera and light back (both checked).
-drop_sel=0 reset_sel=0 zoom_sel=0 eye_sel=0
+drop_sel=0 reset_sel=0 zoom_sel=0 eye_sel=0 shade_sel=0
 selected viewer_bad_dropped_file_keeps_the_face && drop_sel=1
 selected viewer_key_0_resets_camera_and_light && reset_sel=1
 selected viewer_shift_digits_zoom_to_the_eyes_lips_and_cheek && zoom_sel=1
 selected viewer_eyedropper_takes_the_face_colour_into_the_editor && eye_sel=1
-if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
-    rm -f "$out"/z[0-4].txt "$out"/eye[01].txt
+selected viewer_my_shades_persist_and_can_be_picked_again && shade_sel=1
+if [ $((drop_sel + reset_sel + zoom_sel + eye_sel + shade_sel)) -gt 0 ]; then
+    rm -f "$out"/z[0-4].txt "$out"/eye[01].txt "$out"/sh[0-2].txt
+    rm -rf "$out/shade_looks"
     head -c 1000 "$face" >"$out/dropped.rsf"
     # A FIFO dropped too: opening it once blocked the loader, and then the viewer could not be quit.
     rm -f "$out/dropped.fifo" && mkfifo "$out/dropped.fifo"
@@ -255,10 +259,14 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
             echo "move 400 580"
             echo "idle"
             echo "screenshot $out/dbefore_face.png 80 80 630 180"
+            # Each drop starts a load in the frame that takes it; `loaded` then waits for its end (the
+            # error), so the shot below shows what the failed load left.
             echo "drop $out/dropped.rsf"
-            echo "wait 1.5"
+            echo "frames 2"
+            echo "loaded"
             echo "drop $out/dropped.fifo"
-            echo "wait 1.5"
+            echo "frames 2"
+            echo "loaded"
             echo "idle"
             echo "screenshot $out/dafter_face.png 80 80 630 180"
             echo "screenshot $out/dafter_all.png"
@@ -300,7 +308,7 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
             echo "idle"
             echo "state $out/z4.txt"
         fi
-        if [ $eye_sel = 1 ]; then
+        if [ $eye_sel = 1 ] || [ $shade_sel = 1 ]; then
             # Issue 21: V in the product editor takes the colour under the pointer from the rendered face:
             # over the lips (zoomed to with Shift+2) the product turns lip red, whatever the preset was.
             echo "key shift+2"
@@ -311,11 +319,16 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel)) -gt 0 ]; then
             echo "key v"
             echo "idle"
             echo "state $out/eye1.txt"
+            echo "key enter"     # keep it in "my shades" (this launch's library: $out/shade_looks)
+            echo "idle"
+            echo "state $out/sh0.txt"
         fi
         echo "quit"
     } >"$out/views.events"
-    view --events "$out/views.events" >"$out/views.log" 2>&1
+    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" \
+        --events "$out/views.events" >"$out/views.log" 2>&1
     rc=$?
+    views_rc=$rc
 fi
 if [ $drop_sel = 1 ]; then
     name=viewer_bad_dropped_file_keeps_the_face
@@ -358,21 +371,22 @@ if [ $eye_sel = 1 ]; then
 fi
 if selected viewer_s_saves_at_full_quality; then
     # S pressed right after an orbit (the picture still coarse) must save the same picture as S pressed once
-    # it has refined: the shot waits for full quality. Each run in its own folder (S writes ./rouge-NNNN.png).
+    # it has refined: the shot waits for full quality. One session in a folder of its own (S writes
+    # ./rouge-NNNN.png): an orbit drag in view mode (the ladder coarsens while it lasts), S at once
+    # (rouge-0001.png), then once refined, S again at the same camera (rouge-0002.png). S asks where
+    # (prefilled: the next ./rouge-NNNN.png); Enter says yes.
     name=viewer_s_saves_at_full_quality
-    for run in early late; do
-        rm -rf "$out/s_$run" && mkdir -p "$out/s_$run"
-        # An orbit drag in view mode (the ladder coarsens while it lasts), then S at once or after refining.
-        # S asks where (prefilled: ./rouge-0001.png); Enter says yes.
-        if [ $run = early ]; then printf 'key p\nidle\ndrag 300 300 380 300 10\nkey s\nkey enter\nmove 400 580\nidle\nquit\n'
-        else printf 'key p\nidle\ndrag 300 300 380 300 10\nmove 400 580\nidle\nkey s\nkey enter\nidle\nquit\n'; fi >"$out/s_$run.events"
-        (cd "$out/s_$run" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
-            --events "$abs_out/s_$run.events" >"$abs_out/s_$run.log" 2>&1)
-    done
-    if [ ! -f "$out/s_early/rouge-0001.png" ] || [ ! -f "$out/s_late/rouge-0001.png" ]; then
-        echo "FAIL - $name: no screenshot written ($(tail -c 200 "$out/s_early.log"))"
+    rm -rf "$out/s_shot" && mkdir -p "$out/s_shot"
+    # (`frames`: an S in the frame right after the first export's was not taken; `idle` right after the
+    # second Enter would not yet see its export waiting.)
+    printf 'key p\nidle\ndrag 300 300 380 300 10\nkey s\nkey enter\nmove 400 580\nidle\nframes 1\nkey s\nkey enter\nframes 2\nidle\nquit\n' \
+        >"$out/s_shot.events"
+    (cd "$out/s_shot" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+        --events "$abs_out/s_shot.events" >"$abs_out/s_shot.log" 2>&1)
+    if [ ! -f "$out/s_shot/rouge-0001.png" ] || [ ! -f "$out/s_shot/rouge-0002.png" ]; then
+        echo "FAIL - $name: no screenshot written ($(tail -c 200 "$out/s_shot.log"))"
     else
-        m=$("$imgdiff" "$out/s_early/rouge-0001.png" "$out/s_late/rouge-0001.png" 2>&1 | awk '/^max_abs/ {print $2}')
+        m=$("$imgdiff" "$out/s_shot/rouge-0001.png" "$out/s_shot/rouge-0002.png" 2>&1 | awk '/^max_abs/ {print $2}')
         if [ -n "$m" ] && [ "$m" -le 2 ]; then echo "ok - $name"
         else echo "FAIL - $name: the early shot differs from the refined one (max_abs ${m:-error})"; fi
     fi
@@ -713,19 +727,16 @@ if selected viewer_my_shades_persist_and_can_be_picked_again; then
     # Issue 21: a custom shade (here taken from the lips with the eyedropper) kept with Enter goes into
     # "my shades", a file beside the looks; the next session shows it in the editor's row, and a tap on it
     # (the row's first swatch at (422, 408) 24x28 on an 800x600 window) paints with it again.
+    # The first session is the shared launch above (its eyedropper, then Enter); this is the next one.
     name=viewer_my_shades_persist_and_can_be_picked_again
-    rm -rf "$out/shade_looks"
-    printf 'key shift+2\nkey c\nmove 300 320\nidle\nkey v\nkey enter\nidle\nstate %s\nquit\n' "$out/sh0.txt" >"$out/shade0.events"
     printf 'key c\nidle\nstate %s\nclick 434 422\nidle\nstate %s\nquit\n' "$out/sh1.txt" "$out/sh2.txt" >"$out/shade1.events"
-    "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade0.events" \
-        >"$out/shade0.log" 2>&1
-    rc0=$?
+    rc0=${views_rc:-1}
     "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade1.events" \
         >"$out/shade1.log" 2>&1
     rc1=$?
     sv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/sh$1.txt" 2>/dev/null; }
     if [ $rc0 -ne 0 ] || [ $rc1 -ne 0 ] || [ ! -f "$out/sh2.txt" ]; then
-        echo "FAIL - $name: exit $rc0/$rc1: $(tail -c 300 "$out/shade0.log" "$out/shade1.log")"
+        echo "FAIL - $name: exit $rc0/$rc1: $(tail -c 300 "$out/views.log" "$out/shade1.log")"
     elif [ "$(sv 0 shades)" != 1 ] || [ ! -s "$out/shade_looks/shades.txt" ]; then
         echo "FAIL - $name: Enter kept $(sv 0 shades) shades, file: $(head -c 200 "$out/shade_looks/shades.txt" 2>&1)"
     elif [ "$(sv 1 shades)" != 1 ]; then echo "FAIL - $name: the next session has $(sv 1 shades) shades"
