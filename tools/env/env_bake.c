@@ -381,19 +381,32 @@ float rs_env_beckmann(float ndoth, float m)
 
 rs_result rs_env_prefilter(const rs_envmap *full, rs_env_level *lvl, float m, rs_error *err)
 {
+    // The source is a whole number of times the level's width, so that turning an output texel one column
+    // about up turns its lobe by whole source columns: every texel of an output row then has the same
+    // weights, shifted, and a row's weights are computed once (the weight of each source texel for the
+    // row's first texel), not once per output texel.
+    int lw = lvl->width, lh = lvl->height, min_w = RS_MAX(64, 2 * lw), scale = (min_w + lw - 1) / lw;
     rs_envmap src = {0};
-    rs_result r = rs_envmap_resample(full, RS_MAX(64, 2 * lvl->width), &src, err);
+    rs_result r = rs_envmap_resample(full, scale * lw, &src, err);
     if (r != RS_OK) return r;
     int sw = src.w, sh = src.h;
-    float *dirs = texel_dirs(sw, sh);
+    // Rows twice as long (the row, then the row again), so a lobe that wraps round the seam is one run.
+    float *rows = rs_alloc_array((size_t)sh * 2 * (size_t)sw * 3, sizeof(float));
     float *row_sr = malloc((size_t)sh * sizeof(float));
-    if (!dirs || !row_sr) {
-        free(dirs);
-        free(row_sr);
+    float *wts = rs_alloc_array((size_t)sh * (size_t)sw, sizeof(float));
+    int *run = rs_alloc_array((size_t)sh * 3, sizeof(int));  // per source row: first column, length, row
+    float *dirs = texel_dirs(sw, sh);
+    if (!rows || !row_sr || !wts || !run || !dirs) {
+        free(rows), free(row_sr), free(wts), free(run), free(dirs);
         rs_envmap_free(&src);
         return rs_fail(err, RS_ERR_NOMEM, "out of memory prefiltering");
     }
-    for (int j = 0; j < sh; j++) row_sr[j] = (float)rs_envmap_texel_sr(sw, sh, j);
+    for (int j = 0; j < sh; j++) {
+        row_sr[j] = (float)rs_envmap_texel_sr(sw, sh, j);
+        float *d = rows + (size_t)j * 2 * sw * 3;
+        memcpy(d, src.rgb + (size_t)j * sw * 3, (size_t)sw * 3 * sizeof(float));
+        memcpy(d + (size_t)sw * 3, d, (size_t)sw * 3 * sizeof(float));
+    }
     // The lobe is below 1e-5 of its peak where tan(alpha) > m sqrt(ln 1e5) = 3.4 m; l turns twice as far
     // as h. A texel's diagonal more, and never past the horizon (max(R.l, 0) ends the lobe there).
     double texel = 2 * PI / sw, reach = fmin(2 * atan(3.4 * m) + 1.5 * texel, PI / 2 + 1.5 * texel);
@@ -408,50 +421,68 @@ rs_result rs_env_prefilter(const rs_envmap *full, rs_env_level *lvl, float m, rs
         double rl = rl0 + k * step, c2 = 0.5 * (1.0 + rl);
         table[k] = rl <= 0 ? 0.0f : (float)(exp(-(1.0 - rl) / (1.0 + rl) * inv_m2) / (c2 * c2) * rl);
     }
-    for (int oj = 0; oj < lvl->height; oj++) {
-        double theta_r = PI * (oj + 0.5) / lvl->height;
+    for (int oj = 0; oj < lh; oj++) {
+        // The weights of the row's first texel: per source row, the run of columns where the lobe is
+        // above its cut (an arc about the texel's own column: R.l falls with the azimuth difference).
+        float R[3];
+        rs_envmap_texel_dir(lw, lh, 0, oj, R);
+        double theta_r = PI * (oj + 0.5) / lh;
         int j0 = RS_MAX(0, (int)floor((theta_r - reach) / PI * sh));
         int j1 = RS_MIN(sh - 1, (int)ceil((theta_r + reach) / PI * sh));
-        for (int oi = 0; oi < lvl->width; oi++) {
-            float R[3];
-            rs_envmap_texel_dir(lvl->width, lvl->height, oi, oj, R);
-            double phi_r = 2 * PI * ((oi + 0.5) / lvl->width - 0.5);
-            int ic = (int)floor((phi_r / (2 * PI) + 0.5) * sw);
+        int ic = (int)floor((0.5 / lw) * sw), runs = 0;
+        size_t used = 0;
+        double wsum = 0;
+        for (int j = j0; j <= j1; j++) {
+            // Walk out from ic both ways while the lobe lasts (half a turn at most each way).
+            int lo = 0, hi = -1;
+            for (int k = 0; k <= sw / 2; k++) {
+                int i = ((ic - k) % sw + sw) % sw;
+                if (dot3(R, dirs + ((size_t)j * sw + (size_t)i) * 3) <= rl0) break;
+                lo = -k;
+                if (hi < 0) hi = 0;
+            }
+            if (hi < 0) continue;
+            for (int k = 1; k - lo < sw && k <= sw / 2; k++) {
+                if (dot3(R, dirs + ((size_t)j * sw + (size_t)((ic + k) % sw)) * 3) <= rl0) break;
+                hi = k;
+            }
+            int first = ((ic + lo) % sw + sw) % sw, len = hi - lo + 1;
+            run[runs * 3] = first, run[runs * 3 + 1] = len, run[runs * 3 + 2] = j;
+            runs++;
+            for (int k = 0; k < len; k++) {
+                float rl = dot3(R, dirs + ((size_t)j * sw + (size_t)((first + k) % sw)) * 3);
+                float x = rl > rl0 ? (float)((rl - rl0) / step) : 0.0f;
+                int t = RS_MIN((int)x, TABLE - 1);
+                float wgt = rl > rl0 ? (table[t] + (x - (float)t) * (table[t + 1] - table[t])) * row_sr[j] : 0.0f;
+                wts[used + k] = wgt;
+                wsum += wgt;
+            }
+            used += len;
+        }
+        for (int oi = 0; oi < lw; oi++) {
             // (Three scalars, not an array: the compiler keeps them in registers in the inner loop.)
-            double acc0 = 0, acc1 = 0, acc2 = 0, wsum = 0;
-            for (int j = j0; j <= j1; j++) {
-                // Columns of this row inside the cap: cos(dphi) >= (cos reach - cos t cos tr) / (sin t sin tr).
-                int half = sw / 2;
-                double theta = PI * (j + 0.5) / sh, st = sin(theta) * sin(theta_r);
-                // (Rows between a pole inside the cap and the cap's edge get cd <= -1: all columns.)
-                if (st > 1e-9) {
-                    double cd = (cos_reach - cos(theta) * cos(theta_r)) / st;
-                    if (cd > 1) continue;
-                    if (cd > -1) half = RS_MIN(half, (int)ceil(acos(cd) / texel) + 1);
-                }
-                int i_end = half == sw / 2 ? ic + sw - half : ic + half + 1;
-                // ii runs within half a turn of ic (0 <= ic <= sw): one wrap at most, no division per texel.
-                for (int ii = ic - half; ii < i_end; ii++) {
-                    int i = ii < 0 ? ii + sw : ii >= sw ? ii - sw : ii;
-                    size_t t = (size_t)j * sw + i;
-                    float rl = dot3(R, dirs + t * 3);
-                    if (rl <= rl0) continue;
-                    float x = (float)((rl - rl0) / step);
-                    int k = RS_MIN((int)x, TABLE - 1);
-                    float wgt = (table[k] + (x - (float)k) * (table[k + 1] - table[k])) * row_sr[j];
-                    const float *c = src.rgb + t * 3;
+            double acc0 = 0, acc1 = 0, acc2 = 0;
+            const float *w = wts;
+            for (int q = 0; q < runs; q++) {
+                int first = (run[q * 3] + scale * oi) % sw, len = run[q * 3 + 1];
+                const float *c = rows + ((size_t)run[q * 3 + 2] * 2 * sw + (size_t)first) * 3;
+                for (int k = 0; k < len; k++, c += 3) {
+                    float wgt = w[k];
                     acc0 += c[0] * wgt, acc1 += c[1] * wgt, acc2 += c[2] * wgt;
-                    wsum += wgt;
                 }
+                w += len;
             }
             double acc[3] = {acc0, acc1, acc2};
             float out[3];
             for (int k = 0; k < 3; k++) out[k] = wsum > 0 ? (float)(acc[k] / wsum) : 0.0f;
-            lvl->rgb9e5[(size_t)oj * lvl->width + oi] = rs_rgb9e5_pack(out);
+            lvl->rgb9e5[(size_t)oj * lw + oi] = rs_rgb9e5_pack(out);
         }
     }
-    free(dirs);
+    free(rows);
     free(row_sr);
+    free(wts);
+    free(run);
+    free(dirs);
     rs_envmap_free(&src);
     return RS_OK;
 }

@@ -65,7 +65,8 @@ void rs_env_project_sh(const rs_envmap *m, float sh[9][3]);
 float rs_env_beckmann(float ndoth, float m);
 // Prefilters src into lvl (its size and texels set) for roughness m: Lpref(R) = sum w L / sum w,
 // w = P_H(R.h) max(R.l, 0) dw, h = normalize(l + R) (N = V = R). The source is first resampled to twice
-// the level's width (at least 64), and the sum runs over the texels where the lobe is above 1e-5 of its peak.
+// the level's width (at least 64, and a whole multiple of it), and the sum runs over the texels where the
+// lobe is above 1e-5 of its peak.
 rs_result rs_env_prefilter(const rs_envmap *src, rs_env_level *lvl, float m, rs_error *err);
 
 #define RS_ENV_BAKE_LEVELS 6
