@@ -102,6 +102,11 @@ void rs_pack_kdtree_destroy(rs_pack_kdtree *tree);
 // (RS_PACK_NONE skips none). Returns how many were found.
 uint32_t rs_pack_kdtree_query(const rs_pack_kdtree *tree, const float q[3], uint32_t k, uint32_t skip,
                               uint32_t *idx, float *dist);
+// The nearest point to q if one is closer than sqrt(bound2): true and its squared distance in *d2.
+bool rs_pack_kdtree_nearest_within(const rs_pack_kdtree *tree, const float q[3], float bound2, float *d2);
+// Every point within sqrt(r2) of q (distance <= it), in tree order, into ids (room for all the tree's
+// points); returns the count.
+uint32_t rs_pack_kdtree_within(const rs_pack_kdtree *tree, const float q[3], float r2, uint32_t *ids);
 
 // ---------------------------------------------------------------------------------------------------
 // Normals and radii (pack_normals.c).

@@ -68,10 +68,13 @@ static double mirror_cost(const mirror *m, const float n[3], float d)
     for (uint32_t q = 0; q < m->queries; q++) {
         const float *p = m->pos[(size_t)q * m->stride];
         float t = 2.0f * (dot3(p, n) - d), r[3] = {p[0] - t * n[0], p[1] - t * n[1], p[2] - t * n[2]};
-        uint32_t idx;
-        float dist;
-        float d2 = rs_pack_kdtree_query(m->tree, r, 1, RS_PACK_NONE, &idx, &dist) ? dist * dist : m->cap2;
-        sum += fminf(d2, m->cap2);
+        float d2;
+        if (rs_pack_kdtree_nearest_within(m->tree, r, m->cap2, &d2)) {
+            float dist = sqrtf(d2);
+            sum += fminf(dist * dist, m->cap2);
+        } else {
+            sum += m->cap2;
+        }
     }
     return sum / m->queries;
 }
@@ -310,7 +313,6 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
     mr.cap2 = cap * cap;
     float centroid[3] = {(float)c[0], (float)c[1], (float)c[2]}, side[3], plane_d;
     bool ok = find_mirror(&mr, centroid, (const double(*)[3])vec, side, &plane_d, extent);
-    rs_pack_kdtree_destroy(tree);
     // The nose tip: of the points near the mirror plane, the one standing out most along its own normal
     // above rings around it (the mean of (p - q) . n over each ring's points, over the ring's radius,
     // summed over three radii: the nose's size relative to the scan differs between a bust and a face
@@ -319,6 +321,15 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
     float ring[3] = {0.04f * extent, 0.06f * extent, 0.09f * extent};
     for (int k = 0; k < 3; k++) ring[k] = fmaxf(ring[k], (3.0f + k) * spacing);
     float slab = fmaxf(0.01f * extent, 0.75f * spacing), best_h = -INFINITY, tip[3] = {0}, tip_n[3] = {0};
+    // The points within the outer ring come from the tree: a flat model puts every point on its mirror
+    // plane, and scanning all points for each of them was quadratic.
+    uint32_t *near = ok ? rs_alloc_array(n, sizeof *near) : NULL;
+    if (ok && !near) {
+        free(sp), free(sn);
+        rs_pack_kdtree_destroy(tree);
+        return rs_fail(err, RS_ERR_NOMEM, "face: out of memory");
+    }
+    float reach2 = 1.44f * ring[2] * ring[2];
     for (uint32_t i = 0; ok && i < n; i++) {
         if (fabsf(dot3(sp[i], side) - plane_d) > slab) continue;
         float t1[3], t2[3];
@@ -326,7 +337,9 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
         cross3(sn[i], t1, t2);
         double sum[3] = {0, 0, 0};
         uint32_t cnt[3] = {0, 0, 0}, sectors[3] = {0, 0, 0};
-        for (uint32_t j = 0; j < n; j++) {
+        uint32_t near_n = rs_pack_kdtree_within(tree, sp[i], reach2, near);
+        for (uint32_t jj = 0; jj < near_n; jj++) {
+            uint32_t j = near[jj];
             float d[3] = {sp[j][0] - sp[i][0], sp[j][1] - sp[i][1], sp[j][2] - sp[i][2]}, r2 = dot3(d, d);
             if (r2 > 1.44f * ring[2] * ring[2] || dot3(sn[j], sn[i]) < 0) continue;
             float x = dot3(d, t1), y = dot3(d, t2);
@@ -354,6 +367,8 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
             memcpy(tip_n, sn[i], sizeof tip_n);
         }
     }
+    free(near);
+    rs_pack_kdtree_destroy(tree);
     if (ok && best_h > 0) {
         // Rough forward: the mean normal of the face around the tip (2 rings; the tip's own normal
         // tilts with where on the nose the tip point lies), in the mirror plane.

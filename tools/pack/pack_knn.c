@@ -73,13 +73,14 @@ static void build(kd_tree *t, uint32_t node, uint32_t lo, uint32_t hi, const flo
 
 typedef struct kd_best {
     uint32_t k, found;
+    float bound;  // squared distance a point must be under to count (INFINITY: any)
     float d2[RS_PACK_KNN_MAX_K];
     uint32_t id[RS_PACK_KNN_MAX_K];
 } kd_best;
 
 static inline float worst(const kd_best *b)
 {
-    return b->found < b->k ? INFINITY : b->d2[b->k - 1];
+    return b->found < b->k ? b->bound : b->d2[b->k - 1];
 }
 
 static void query(const kd_tree *t, uint32_t node, uint32_t lo, uint32_t hi, const float q[3],
@@ -163,13 +164,47 @@ rs_result rs_pack_kdtree_create(const float (*pos)[3], uint32_t count, rs_pack_k
 uint32_t rs_pack_kdtree_query(const rs_pack_kdtree *tree, const float q[3], uint32_t k, uint32_t skip,
                               uint32_t *idx, float *dist)
 {
-    kd_best b = {.k = RS_MIN(k, (uint32_t)RS_PACK_KNN_MAX_K)};
+    kd_best b = {.k = RS_MIN(k, (uint32_t)RS_PACK_KNN_MAX_K), .bound = INFINITY};
     if (b.k > 0) query(&tree->t, 0, 0, tree->t.n, q, skip, &b);
     for (uint32_t i = 0; i < b.found; i++) {
         idx[i] = b.id[i];
         dist[i] = sqrtf(b.d2[i]);
     }
     return b.found;
+}
+
+bool rs_pack_kdtree_nearest_within(const rs_pack_kdtree *tree, const float q[3], float bound2, float *d2)
+{
+    // The bound prunes every branch farther than it, which is what makes a truncated distance cheap far
+    // from the points (a mirror plane candidate that reflects the scan into empty space).
+    kd_best b = {.k = 1, .bound = bound2};
+    query(&tree->t, 0, 0, tree->t.n, q, RS_PACK_NONE, &b);
+    if (b.found) *d2 = b.d2[0];
+    return b.found > 0;
+}
+
+static void within(const kd_tree *t, uint32_t node, uint32_t lo, uint32_t hi, const float q[3], float r2,
+                   uint32_t *ids, uint32_t *n)
+{
+    if (hi - lo <= LEAF_SIZE) {
+        for (uint32_t i = lo; i < hi; i++) {
+            const kd_point *p = &t->pts[i];
+            float dx = p->p[0] - q[0], dy = p->p[1] - q[1], dz = p->p[2] - q[2];
+            if (dx * dx + dy * dy + dz * dz <= r2) ids[(*n)++] = p->id;
+        }
+        return;
+    }
+    uint32_t mid = lo + (hi - lo) / 2;
+    float d = q[t->axis[node]] - t->split[node];
+    if (d < 0 || d * d <= r2) within(t, 2 * node + 1, lo, mid, q, r2, ids, n);
+    if (d >= 0 || d * d <= r2) within(t, 2 * node + 2, mid, hi, q, r2, ids, n);
+}
+
+uint32_t rs_pack_kdtree_within(const rs_pack_kdtree *tree, const float q[3], float r2, uint32_t *ids)
+{
+    uint32_t n = 0;
+    within(&tree->t, 0, 0, tree->t.n, q, r2, ids, &n);
+    return n;
 }
 
 void rs_pack_knn_free(rs_pack_knn *knn)
@@ -201,7 +236,7 @@ rs_result rs_pack_knn_compute(const float (*pos)[3], uint32_t count, uint32_t k,
     // Queries in tree order: neighbouring queries walk the same nodes, so they stay in cache.
     const kd_tree *t = &tree->t;
     for (uint32_t j = 0; j < count; j++) {
-        kd_best b = {.k = k};
+        kd_best b = {.k = k, .bound = INFINITY};
         uint32_t id = t->pts[j].id;
         query(t, 0, 0, count, t->pts[j].p, id, &b);
         for (uint32_t i = 0; i < k; i++) {
