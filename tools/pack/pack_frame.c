@@ -61,11 +61,14 @@ typedef struct mirror {
     float cap2;  // squared truncation distance
 } mirror;
 
-// Mean truncated squared distance from the reflected query points to the scan.
-static double mirror_cost(const mirror *m, const float n[3], float d)
+// Mean truncated squared distance from the reflected query points to the scan. The callers only keep a
+// plane that costs less than `bound`: once the partial mean (every term is >= 0) reaches it, that mean
+// is returned as it is, which the caller turns down just as it would the whole.
+static double mirror_cost(const mirror *m, const float n[3], float d, double bound)
 {
     double sum = 0;
     for (uint32_t q = 0; q < m->queries; q++) {
+        if ((q & 63) == 63 && sum / m->queries >= bound) break;
         const float *p = m->pos[(size_t)q * m->stride];
         float t = 2.0f * (dot3(p, n) - d), r[3] = {p[0] - t * n[0], p[1] - t * n[1], p[2] - t * n[2]};
         float d2;
@@ -103,7 +106,7 @@ static bool find_mirror(const mirror *m, const float centroid[3], const double v
             for (int i = 0; i < 3; i++) n[i] = (float)(cosf(t) * a[i] + sinf(t) * b[i]);
             if (!normalize3(n)) continue;
             float d = dot3(centroid, n);
-            double c = mirror_cost(m, n, d);
+            double c = mirror_cost(m, n, d, seed_cost[2]);
             // Keep the three best distinct seeds.
             for (int s = 0; s < 3; s++)
                 if (c < seed_cost[s]) {
@@ -139,7 +142,7 @@ static bool find_mirror(const mirror *m, const float centroid[3], const double v
                     memcpy(cn, n, sizeof cn);
                     cd = d + ((k & 1) ? -dstep : dstep);
                 }
-                double cc = mirror_cost(m, cn, cd);
+                double cc = mirror_cost(m, cn, cd, c);
                 if (cc < c) {
                     c = cc;
                     memcpy(n, cn, sizeof n);
@@ -285,6 +288,12 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
     // only scales steps and the truncation, so a rough size is enough: the RMS radius.
     float extent = (float)sqrt((w[0] + w[1] + w[2]) / n) * 2.0f;
     (void)lo, (void)hi;
+    // A flat model (its thinnest spread under 0.1 % of its widest: a quad, a sheet, a decal) has nothing
+    // standing out of it: no nose, and a face's depths (0.2 face heights) are not there to match.
+    if (!(w[0] > 1e-6 * w[2])) {
+        free(sp), free(sn);
+        return RS_OK;
+    }
     rs_pack_kdtree *tree = NULL;
     rs_result r = rs_pack_kdtree_create((const float(*)[3])sp, n, &tree, err);
     if (r != RS_OK || !(extent > 0) || !isfinite(extent)) {
