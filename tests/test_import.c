@@ -365,8 +365,9 @@ static void test_scale_rule_reads_units_from_the_head(void)
     for (size_t k = 0; k < RS_COUNT_OF(cases); k++) {
         for (uint32_t i = 0; i < m->vertex_count; i++)
             for (int a = 0; a < 3; a++) m->pos[i][a] = orig[i][a] * cases[k].scale;
-        // (No ambient occlusion: the unit rule reads the face, and occlusion was most of each conversion.)
-        rs_pack_desc d = {.points = 20000, .mm_per_unit = cases[k].given, .declared_mm_per_unit = cases[k].declared,
+        // (No ambient occlusion: the unit rule reads the face, and occlusion was most of each conversion. The
+        // face comes from a sample of its own whatever --points asks, so a few thousand splats do.)
+        rs_pack_desc d = {.points = 3000, .mm_per_unit = cases[k].given, .declared_mm_per_unit = cases[k].declared,
                           .declared_unit = "test", .no_ao = true};
         rs_pack_report rep;
         rs_splat_cloud *c = NULL;

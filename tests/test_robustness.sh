@@ -226,7 +226,7 @@ bad_input import_not_a_model "a PNG given as the scan" 1 "not a model rouge-pack
     "$pack" tests/fixtures/image/a_8x8.png -o "$tmp/o.rsf"
 # A texture never stops a conversion (issue 24): one warning line, exit 0, the default colour instead.
 warns_and_converts import_missing_texture "OBJ whose MTL names a missing texture" "which is not there" \
-    "$pack" tests/fixtures/import/bad_missing_texture.obj -o "$tmp/w.rsf"
+    "$pack" tests/fixtures/import/bad_missing_texture.obj -o "$tmp/w.rsf" --points 2000
 bad_input import_texture_truncated_jpeg "--texture: a JPEG cut in half" 1 "JPEG is truncated" "$tmp/o.rsf" \
     "$pack" tests/fixtures/ply/mesh_st.ply --points 100 --texture tests/fixtures/import/bad_truncated.jpg -o "$tmp/o.rsf"
 bad_input import_texture_huge_jpeg "--texture: JPEG header claiming 16000 x 16000 pixels" 1 "Mpx allowed" "$tmp/o.rsf" \
