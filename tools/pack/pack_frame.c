@@ -54,11 +54,97 @@ static void perpendicular(const float n[3], float out[3])
     normalize3(out);
 }
 
+// The scan's points bucketed in cubes a little wider than the mirror cost's truncation distance: a
+// point nearer a query than that lies in the 27 cubes around it. Per query that is cheaper than the k-d
+// tree's walk (a good plane's reflections land on the surface, where the walk backtracks), and it finds
+// the same nearest distance.
+typedef struct grid {
+    double o[3], inv;  // origin and 1 / cube side (double: a scan far from the origin keeps its cells)
+    int dim[3];
+    uint32_t *start;   // dim[0] dim[1] dim[2] + 1 offsets into pts, cell by cell (x fastest)
+    float (*pts)[3];
+} grid;
+
+#define GRID_MAX_CELLS (1u << 22)
+
+static int grid_cell(const grid *g, float v, int a)
+{
+    double c = floor(((double)v - g->o[a]) * g->inv);
+    return c < -1 ? -1 : c > g->dim[a] ? g->dim[a] : (int)c;
+}
+
+// False (g->start NULL) when the cubes would be too many (a few far outliers): the tree answers then.
+static bool grid_build(grid *g, const float (*p)[3], uint32_t n, const float lo[3], const float hi[3], float cell)
+{
+    memset(g, 0, sizeof *g);
+    size_t cells = 1;
+    for (int a = 0; a < 3; a++) {
+        double d = floor(((double)hi[a] - lo[a]) / cell) + 1;
+        if (!(d >= 1 && d <= GRID_MAX_CELLS)) return false;
+        g->dim[a] = (int)d;
+        g->o[a] = lo[a];
+        cells *= (size_t)d;
+        if (cells > GRID_MAX_CELLS) return false;
+    }
+    g->inv = 1.0 / cell;
+    g->start = calloc(cells + 1, sizeof *g->start);
+    g->pts = rs_alloc_array(n, sizeof *g->pts);
+    uint32_t *at = rs_alloc_array(n, sizeof *at);
+    if (!g->start || !g->pts || !at) {
+        free(g->start), free(g->pts), free(at);
+        g->start = NULL, g->pts = NULL;
+        return false;
+    }
+    for (uint32_t i = 0; i < n; i++) {
+        int x = grid_cell(g, p[i][0], 0), y = grid_cell(g, p[i][1], 1), z = grid_cell(g, p[i][2], 2);
+        at[i] = (uint32_t)(((size_t)z * g->dim[1] + (size_t)y) * g->dim[0] + (size_t)x);
+        g->start[at[i] + 1]++;
+    }
+    for (size_t c = 0; c < cells; c++) g->start[c + 1] += g->start[c];
+    for (uint32_t i = 0; i < n; i++) memcpy(g->pts[g->start[at[i]]++], p[i], sizeof *g->pts);
+    for (size_t c = cells; c > 0; c--) g->start[c] = g->start[c - 1];  // back to the first of each cell
+    g->start[0] = 0;
+    free(at);
+    return true;
+}
+
+static void grid_free(grid *g)
+{
+    free(g->start);
+    free(g->pts);
+}
+
+// As rs_pack_kdtree_nearest_within: the smallest squared distance under bound2 (which is at most the
+// cube side squared), false when no point is that near.
+static bool grid_nearest_within(const grid *g, const float q[3], float bound2, float *d2)
+{
+    int c[3];
+    for (int a = 0; a < 3; a++) c[a] = grid_cell(g, q[a], a);
+    float best = bound2;
+    bool found = false;
+    for (int z = RS_MAX(c[2] - 1, 0); z <= RS_MIN(c[2] + 1, g->dim[2] - 1); z++)
+        for (int y = RS_MAX(c[1] - 1, 0); y <= RS_MIN(c[1] + 1, g->dim[1] - 1); y++) {
+            size_t row = ((size_t)z * g->dim[1] + (size_t)y) * g->dim[0];
+            int x0 = RS_MAX(c[0] - 1, 0), x1 = RS_MIN(c[0] + 1, g->dim[0] - 1);
+            if (x0 > x1) continue;
+            // The cells of a row are consecutive: one run of points.
+            for (uint32_t i = g->start[row + (size_t)x0]; i < g->start[row + (size_t)x1 + 1]; i++) {
+                const float *p = g->pts[i];
+                float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+                float e = dx * dx + dy * dy + dz * dz;
+                if (e < best) best = e, found = true;
+            }
+        }
+    if (found) *d2 = best;
+    return found;
+}
+
 typedef struct mirror {
     const float (*pos)[3];
     uint32_t count, queries, stride;
     const rs_pack_kdtree *tree;
-    float cap2;  // squared truncation distance
+    const grid *grid;  // NULL: the tree
+    float cap2;        // squared truncation distance
 } mirror;
 
 // Mean truncated squared distance from the reflected query points to the scan. The callers only keep a
@@ -72,7 +158,7 @@ static double mirror_cost(const mirror *m, const float n[3], float d, double bou
         const float *p = m->pos[(size_t)q * m->stride];
         float t = 2.0f * (dot3(p, n) - d), r[3] = {p[0] - t * n[0], p[1] - t * n[1], p[2] - t * n[2]};
         float d2;
-        if (rs_pack_kdtree_nearest_within(m->tree, r, m->cap2, &d2)) {
+        if (m->grid ? grid_nearest_within(m->grid, r, m->cap2, &d2) : rs_pack_kdtree_nearest_within(m->tree, r, m->cap2, &d2)) {
             float dist = sqrtf(d2);
             sum += fminf(dist * dist, m->cap2);
         } else {
@@ -287,7 +373,6 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
     // The diagonal of the bounding box does not depend on orientation up to the box's own rotation; it
     // only scales steps and the truncation, so a rough size is enough: the RMS radius.
     float extent = (float)sqrt((w[0] + w[1] + w[2]) / n) * 2.0f;
-    (void)lo, (void)hi;
     // A flat model (its thinnest spread under 0.1 % of its widest: a quad, a sheet, a decal) has nothing
     // standing out of it: no nose, and a face's depths (0.2 face heights) are not there to match.
     if (!(w[0] > 1e-6 * w[2])) {
@@ -320,8 +405,11 @@ rs_result rs_pack_orient(const float (*pos)[3], const float (*normal)[3], uint32
     mr.stride = n / mr.queries;
     float cap = 0.03f * extent;
     mr.cap2 = cap * cap;
+    grid g;
+    if (grid_build(&g, (const float(*)[3])sp, n, lo, hi, cap * 1.001f)) mr.grid = &g;
     float centroid[3] = {(float)c[0], (float)c[1], (float)c[2]}, side[3], plane_d;
     bool ok = find_mirror(&mr, centroid, (const double(*)[3])vec, side, &plane_d, extent);
+    if (mr.grid) grid_free(&g);
     // The nose tip: of the points near the mirror plane, the one standing out most along its own normal
     // above rings around it (the mean of (p - q) . n over each ring's points, over the ring's radius,
     // summed over three radii: the nose's size relative to the scan differs between a bust and a face
