@@ -111,6 +111,37 @@ static void test_knn_matches_brute_force(void)
         }
     }
     RS_CHECK(bad == 0, "%d neighbour distances differ from brute force", bad);
+    // The bounded queries the face search uses: the nearest point under a bound (the same squared distance
+    // as a scan of all points, or none) and every point within a radius (the same set), at points on, off
+    // and far from the sphere.
+    rs_pack_kdtree *t = NULL;
+    uint32_t *ids = malloc(n * sizeof *ids), *mark = calloc(n, sizeof *mark);
+    RS_REQUIRE(rs_pack_kdtree_create((const float(*)[3])p, n, &t, &err) == RS_OK, "%s", err.msg);
+    int bad_near = 0, bad_within = 0;
+    for (uint32_t i = 0; i < n; i += 11) {
+        float q[3] = {p[i][0] * (1 + 0.1f * (i % 3)), p[i][1] * (1 + 0.1f * (i % 3)), p[i][2] + 0.05f * (i % 5)};
+        float bound2 = 0.01f * (float)(1 + i % 4), best = bound2, got = -1;
+        uint32_t want_n = 0;
+        for (uint32_t j = 0; j < n; j++) {
+            float dx = p[j][0] - q[0], dy = p[j][1] - q[1], dz = p[j][2] - q[2], e = dx * dx + dy * dy + dz * dz;
+            if (e < best) best = e;
+            want_n += e <= bound2;
+        }
+        bool found = rs_pack_kdtree_nearest_within(t, q, bound2, &got);
+        bad_near += found != (best < bound2) || (found && got != best);
+        uint32_t m = rs_pack_kdtree_within(t, q, bound2, ids);
+        for (uint32_t a = 0; a < m; a++) {
+            float dx = p[ids[a]][0] - q[0], dy = p[ids[a]][1] - q[1], dz = p[ids[a]][2] - q[2];
+            bad_within += dx * dx + dy * dy + dz * dz > bound2 || mark[ids[a]] == i + 1;  // outside, or twice
+            mark[ids[a]] = i + 1;
+        }
+        bad_within += m != want_n;
+    }
+    RS_CHECK(bad_near == 0 && bad_within == 0, "bounded queries differ from brute force: %d nearest, %d within",
+             bad_near, bad_within);
+    rs_pack_kdtree_destroy(t);
+    free(ids);
+    free(mark);
     rs_pack_knn_free(&knn);
     free(d);
     free(p);
