@@ -27,8 +27,13 @@
 #define RS_PACK_DEFAULT_MIN_LOD 10000u
 #define RS_PACK_DEFAULT_SEED 20240600u
 // A mesh's face (frame and landmarks) is found on its own sample of this many points, drawn with the same
-// seed whatever --points asks for, so the face height does not depend on the requested count.
+// seed whatever --points asks for, so the face height does not depend on the requested count. A small mesh
+// gets RS_PACK_FACE_SAMPLE_PER_TRIANGLE points a triangle it keeps, at least RS_PACK_FACE_SAMPLE_MIN: its
+// shape is all in its few flat triangles, and the search's work follows the sample's size (any mesh of
+// 3125 triangles or more, every scan, gets the whole sample).
 #define RS_PACK_FACE_SAMPLE_POINTS 50000u
+#define RS_PACK_FACE_SAMPLE_PER_TRIANGLE 16u
+#define RS_PACK_FACE_SAMPLE_MIN 2000u
 // Normals are stored on a 12-bit octahedral lattice (at most 0.05 degrees from the 16-bit code; a scan's
 // normal map resolves ~0.5 degrees): 2 bytes a splat less in a v2 .rsf (rs_splat_quantize_normals).
 #define RS_PACK_NORMAL_BITS 12

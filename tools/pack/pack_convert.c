@@ -434,7 +434,10 @@ rs_result rs_pack_convert(const rs_ply_mesh *in, const rs_pack_desc *desc, rs_sp
         // A mesh's face comes from a sample of its own, the same at every requested count: on the splats
         // themselves the random sample tilts the face frame by up to ~0.7 deg, which moves the face
         // height by ~1 % (10k vs 300k points: 2 %). Normal maps tilt the frame's normals as the splats'.
-        rs_pack_sample_desc fd = {.points = RS_PACK_FACE_SAMPLE_POINTS, .seed = d->seed,
+        uint64_t kept = (uint64_t)in->tri_count - RS_MIN(rep->triangles_dropped, in->tri_count);
+        uint32_t face_points = (uint32_t)RS_CLAMP(kept * RS_PACK_FACE_SAMPLE_PER_TRIANGLE, (uint64_t)RS_PACK_FACE_SAMPLE_MIN,
+                                                  (uint64_t)RS_PACK_FACE_SAMPLE_POINTS);
+        rs_pack_sample_desc fd = {.points = face_points, .seed = d->seed,
                                   .all_components = d->all_components, .normal_map = d->normal_map};
         rs_pack_points fp = {0};
         uint32_t dropped = 0;
