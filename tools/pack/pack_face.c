@@ -55,6 +55,7 @@ typedef struct hmap {
     int w, h;          // cells along s and u
     float s0, u0, cell;
     float *f;          // forward coordinate of the front-most surface, -INFINITY where empty
+    float ring[16][2]; // cos, sin of the 16 directions protrusion() samples (computed once)
 } hmap;
 
 static float hm_get(const hmap *m, int x, int y)
@@ -138,18 +139,20 @@ static void hm_blur(hmap *m, int r, float *tmp)
 
 // How far the surface at (s, u) stands in front of a ring of radius rho around it: f minus the largest
 // of 16 ring samples. Narrow bumps (the nose) score high; broad ones (brow, chin, cheeks) do not.
-static float protrusion(const hmap *m, float s, float u, float rho)
+// A search for the largest passes the best so far as `beat`: once the samples seen rule out beating it
+// (the answer only falls as samples come), -INFINITY comes back at once, as for a ring off the surface.
+static float protrusion(const hmap *m, float s, float u, float rho, float beat)
 {
     float c = hm_at(m, s, u);
     if (c == -INFINITY) return -INFINITY;
     float best = -INFINITY;
     int seen = 0;
     for (int k = 0; k < 16; k++) {
-        float a = (float)k * 0.39269908f;  // 2 pi / 16
-        float v = hm_at(m, s + rho * cosf(a), u + rho * sinf(a));
+        float v = hm_at(m, s + rho * m->ring[k][0], u + rho * m->ring[k][1]);
         if (v == -INFINITY) continue;
         best = fmaxf(best, v);
         seen++;
+        if (c - best <= beat) return -INFINITY;
     }
     return seen >= 12 ? c - best : -INFINITY;  // the ring must lie mostly on the surface
 }
@@ -218,7 +221,7 @@ static void face_evidence(const hmap *m, rs_pack_face *f, float nose_s, float no
         for (int j = 0; j <= 10; j++)
             for (int i = 0; i <= 7; i++) {
                 float s = nose_s + dir * (0.07f + 0.02f * i) * H, u = nose_u + (0.04f + 0.02f * j) * H;
-                float d = -protrusion(m, s, u, 0.06f * H);
+                float d = -protrusion(m, s, u, 0.06f * H, -INFINITY);
                 if (d != INFINITY && d > eye_d[side]) eye_d[side] = d, eye_s[side] = s, eye_u[side] = u;
             }
     }
@@ -287,7 +290,7 @@ static bool find_landmarks(const float (*pos)[3], const float (*normal)[3], uint
     for (int y = hm_y(m, top_u - 1.0f * h0); y <= hm_y(m, top_u - 0.3f * h0); y++)
         for (int x = hm_x(m, s_mid - 0.2f * head_w); x <= hm_x(m, s_mid + 0.2f * head_w); x++) {
             float s = m->s0 + (x + 0.5f) * m->cell, u = m->u0 + (y + 0.5f) * m->cell;
-            float p = protrusion(m, s, u, rho);
+            float p = protrusion(m, s, u, rho, best_p);
             if (p > best_p) {
                 best_p = p;
                 nose_s = s;
@@ -595,6 +598,10 @@ rs_result rs_pack_find_face_frame(const float (*pos)[3], const float (*normal)[3
         return RS_OK;
     }
     hmap m = {.cell = ext / 64.0f};
+    for (int k = 0; k < 16; k++) {
+        float a = (float)k * 0.39269908f;  // 2 pi / 16
+        m.ring[k][0] = cosf(a), m.ring[k][1] = sinf(a);
+    }
     m.s0 = lo[0] - 2 * m.cell;
     m.u0 = lo[1] - 2 * m.cell;
     m.w = (int)((hi[0] - lo[0]) / m.cell) + 5;
