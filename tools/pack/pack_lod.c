@@ -300,8 +300,12 @@ rs_result rs_pack_lod_order(const float (*pos)[3], uint32_t count, uint32_t min_
     uint32_t *perm = rs_alloc_array(count, sizeof *perm);
     uint8_t *level = rs_alloc_array(count, sizeof *level);   // finest level that holds the point
     keyed *tmp = rs_alloc_array(count, sizeof *tmp);
+    // The candidates' positions and levels in the order they are tried: the passes below read them in
+    // sequence instead of jumping about the scan.
+    float(*tried)[3] = rs_alloc_array(count, sizeof *tried);
+    uint8_t *tried_level = rs_alloc_array(count, sizeof *tried_level);
     rs_result res = RS_OK;
-    if (!g.head || !g.node || !perm || !level || !tmp) {
+    if (!g.head || !g.node || !perm || !level || !tmp || !tried || !tried_level) {
         res = rs_fail(err, RS_ERR_NOMEM, "lod: out of memory for %u points", count);
         goto out;
     }
@@ -326,6 +330,10 @@ rs_result rs_pack_lod_order(const float (*pos)[3], uint32_t count, uint32_t min_
         perm[i - 1] = perm[j];
         perm[j] = t;
     }
+    for (uint32_t i = 0; i < count; i++) {
+        memcpy(tried[i], pos[perm[i]], sizeof tried[i]);
+        tried_level[i] = 0;
+    }
 
     // Coarse to fine: level l accepts, among points not yet taken, those at least r_l away from every
     // point taken so far, so each level's set contains all coarser ones.
@@ -335,7 +343,7 @@ rs_result rs_pack_lod_order(const float (*pos)[3], uint32_t count, uint32_t min_
         double r = area > 0 ? sqrt(RSA_DENSITY * area / want) : 0.0;
         grid_reset(&g, (float)r, want + want / 2, table);
         for (uint32_t i = 0; i < count; i++)
-            if (level[i] != 0) grid_insert(&g, pos[i]);
+            if (tried_level[i] != 0) grid_insert(&g, tried[i]);
         uint32_t before = accepted;
         float r2 = (float)(r * r);
         // A finite candidate set saturates below the continuous density once r nears the input's own
@@ -343,10 +351,9 @@ rs_result rs_pack_lod_order(const float (*pos)[3], uint32_t count, uint32_t min_
         // than the new r) and the 27 cells of the old size still cover the smaller radius.
         for (int pass = 0; pass < 3; pass++) {
             for (uint32_t i = 0; i < count; i++) {
-                uint32_t p = perm[i];
-                if (level[p] != 0 || !grid_free(&g, pos[p], r2)) continue;
-                grid_insert(&g, pos[p]);
-                level[p] = (uint8_t)l;
+                if (tried_level[i] != 0 || !grid_free(&g, tried[i], r2)) continue;
+                grid_insert(&g, tried[i]);
+                tried_level[i] = (uint8_t)l;
                 accepted++;
             }
             // Learn the effective area from what the first pass achieved, so sizes track N / 2^l.
@@ -356,6 +363,8 @@ rs_result rs_pack_lod_order(const float (*pos)[3], uint32_t count, uint32_t min_
         }
         if (progress) progress(user, (double)(levels - l) / levels);
     }
+
+    for (uint32_t i = 0; i < count; i++) level[perm[i]] = tried_level[i];
 
     // Counting sort by level, coarse first, then Morton order inside each level.
     uint32_t level_size[RS_SPLAT_MAX_LODS] = {0};
@@ -394,5 +403,7 @@ out:
     free(perm);
     free(level);
     free(tmp);
+    free(tried);
+    free(tried_level);
     return res;
 }
