@@ -135,13 +135,18 @@ check_stroke() {
     fi
 }
 
-# One session for five checks: a stroke, undo, a look saved and loaded, the recording, and the region brush
-# (after a clear, on the bare face again).
+# One session for six checks: the loading screens, a stroke, undo, a look saved and loaded, the region
+# brush (after a clear, on the bare face again) and the smudge tool; the recording of all of it replays.
+sm="$out/smudge"
 if selected viewer_script_stroke_changes_only_the_painted_area || selected viewer_undo_restores_the_picture_exactly ||
     selected viewer_look_saved_and_loaded_renders_the_same || selected viewer_records_a_replayable_stroke_file ||
-    selected viewer_region_brush_keeps_lipstick_on_the_lips; then
-    rm -rf "$out/rec.strokes" "$out/looks"
+    selected viewer_region_brush_keeps_lipstick_on_the_lips ||
+    selected viewer_loading_reports_the_first_frame_stages_and_j_smudges; then
+    rm -rf "$out/rec.strokes" "$out/looks" "$sm"
+    mkdir -p "$sm"
     {
+        echo "loaded"
+        echo "state $sm/s0.txt"   # the loading screens (viewer_loading_reports_the_first_frame_stages_...)
         echo "key i"          # HUD off: its numbers change from frame to frame
         shots before
         echo "key p"          # paint mode
@@ -169,6 +174,17 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
         echo "key k"
         echo "drag 370 150 430 150 30"
         shots kfree
+        # The smudge tool (J): a lipstick stripe dragged down carries its colour below it.
+        echo "drag 340 140 460 140 12"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $sm/a.png 330 100 140 130"
+        echo "key j"
+        echo "drag 400 140 400 215 12"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $sm/b.png 330 100 140 130"
+        echo "state $sm/s1.txt"
         echo "quit"
     } | sc >"$out/stroke.events"
     view --events "$out/stroke.events" --record "$out/rec.strokes" >"$out/script.log" 2>&1
@@ -792,19 +808,16 @@ fi
 if selected viewer_loading_reports_the_first_frame_stages_and_j_smudges; then
     # Loading shows real progress: the face is made with its first frame, and the loading screen is drawn
     # at each stage create reports (ten: reading .. lighting, the frame's five, done), fractions never
-    # going back. Then the smudge tool (J): a lipstick stripe dragged down carries its colour below it.
+    # going back. Then the smudge tool (J): a lipstick stripe dragged down carries its colour below it. Both
+    # in the stroke session above (the face's first load; the stripe last, lipstick anywhere).
     name=viewer_loading_reports_the_first_frame_stages_and_j_smudges
-    d="$out/smudge"
-    mkdir -p "$d"
-    printf 'loaded\nstate %s/s0.txt\nkey p\nkey 9\nkey k\ndrag 340 140 460 140 12\nmove 400 580\nidle\nscreenshot %s/a.png 330 100 140 130\nkey j\ndrag 400 140 400 215 12\nmove 400 580\nidle\nscreenshot %s/b.png 330 100 140 130\nscreenshot %s/far.png 80 260 630 150\nstate %s/s1.txt\nquit\n' \
-        "$d" "$d" "$d" "$d" "$d" | sc >"$d/smudge.events"
-    view --events "$d/smudge.events" >"$d/smudge.log" 2>&1
-    rc=$?
+    d="$sm"
+    rc=$stroke_rc
     sval() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$d/$1.txt" 2>/dev/null; }
     stages=$(sval s0 loading_stages)
     # Below the stripe (y 160..215 of the window: rows 60..115 of the shots), the smudge's column changed.
     below=$("$imgdiff" "$d/a.png" "$d/b.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
-    if [ $rc -ne 0 ] || [ ! -f "$d/s1.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$d/smudge.log")"
+    if [ $rc -ne 0 ] || [ ! -f "$d/s1.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/script.log")"
     elif [ "$(sval s0 loading_screens)" != 10 ] ||
         ! echo "$stages" | awk -F';' '{
             want = "reading the face|uploading and compiling|makeup layer|lighting|shadow map|visibility|attributes|light and diffusion|composite|done"
