@@ -443,10 +443,15 @@ static void load_abort(vw_viewer *v)
 static void build_rungs(vw_viewer *v)
 {
     const rouge_stats *h = &v->info;
-    uint32_t nl = RS_MAX(h->lod_count, 1u);
+    // No rung draws more splats than the picture at rest (--max-splats): moving, the face once drew
+    // half again as many as at rest.
+    uint32_t full = v->cli->view.max_splats ? RS_MIN(v->cli->view.max_splats, h->splats) : h->splats;
+    uint32_t nl = 0;
     uint32_t lods[ROUGE_MAX_LODS];
-    for (uint32_t i = 0; i < nl; i++) lods[i] = h->lod_count ? h->lods[i] : h->splats;
-    uint32_t floor_n = RS_MIN(h->splats, RS_MAX(DENSE_SPLATS, 1u));
+    lods[nl++] = full;
+    for (uint32_t i = 0; i < h->lod_count && nl < ROUGE_MAX_LODS; i++)
+        if (h->lods[i] < full) lods[nl++] = h->lods[i];
+    uint32_t floor_n = RS_MIN(full, RS_MAX(DENSE_SPLATS, 1u));
     uint32_t fi = 0;
     while (fi + 1 < nl && lods[fi + 1] >= floor_n) fi++;
     int n = 0;
@@ -458,7 +463,7 @@ static void build_rungs(vw_viewer *v)
     v->rung_count = n;
     // First guess: about a quarter of the splats at full resolution; the controller adapts from there.
     v->rung = 0;
-    while (v->rung + 1 <= (int)fi && v->rungs[v->rung].max_splats > h->splats / 4) v->rung++;
+    while (v->rung + 1 <= (int)fi && v->rungs[v->rung].max_splats > full / 4) v->rung++;
 }
 
 static void face_close(vw_viewer *v)
@@ -896,14 +901,22 @@ static void update_window_size(vw_viewer *v)
     glfwGetWindowSize(v->win, &ww, &wh);
     glfwGetFramebufferSize(v->win, &fw, &fh);
     if (fw < 1 || fh < 1 || ww < 1 || wh < 1) return;  // minimised
-    if (fw != v->fb_w || fh != v->fb_h) v->dirty_view = true, mark_input(v);
+    // A resize is input (the picture coarsens while it lasts); the window's first size is not: marking it
+    // once cost every start a few coarse renders of the face and one more full one.
+    if (fw != v->fb_w || fh != v->fb_h) {
+        v->dirty_view = true;
+        if (v->fb_w > 0) mark_input(v);
+    }
     v->win_w = ww, v->win_h = wh, v->fb_w = fw, v->fb_h = fh;
     v->px_per_pt = (float)fw / (float)ww;
     float cx = 1, cy = 1;
     glfwGetWindowContentScale(v->win, &cx, &cy);
     // Content scale is pixels per point on every platform GLFW supports (macOS: the Retina factor,
     // X11/Wayland/Windows: the DPI setting); fall back to the framebuffer ratio.
-    v->ui_scale = RS_CLAMP(RS_MAX(cx, v->px_per_pt), 1.0f, 4.0f);
+    // A window smaller than the UI's design size scales all of it down together (toolbar, editor, sheets,
+    // text): the toolbar alone once shrank and the rest overlapped it.
+    float fit = RS_MIN((float)ww / VW_UI_DESIGN_W, (float)wh / VW_UI_DESIGN_H);
+    v->ui_scale = RS_CLAMP(RS_MAX(cx, v->px_per_pt), 1.0f, 4.0f) * RS_CLAMP(fit, 0.25f, 1.0f);
 }
 
 double vw_now(void) { return glfwGetTime(); }

@@ -48,6 +48,9 @@ typedef struct vw_event {
     char path[512];        // VW_DROP
 } vw_event;
 
+// The UI's design size in points: the toolbar fits it at scale 1; smaller windows scale the whole UI down.
+#define VW_UI_DESIGN_W 800.0f
+#define VW_UI_DESIGN_H 600.0f
 #define VW_QUEUE_CAP 4096
 
 typedef struct vw_queue {

@@ -6,7 +6,8 @@
 # of the process and trips valgrind in places: tests/valgrind.supp suppresses only stacks that pass
 # through those libraries.
 #
-# Kept small to fit `make test` (~30 s on 2 cores): the render uses a 3000-splat face converted here.
+# Kept small to fit `make test` (~75 CPU-s on one core, most of them the render, and about half of the
+# render's llvmpipe drawing the mobile 2048^2 shadow map): the render uses a 3000-splat face converted here.
 # RS_VALGRIND_FACE=1 (make test-full) adds the bundled 600k face at --max-splats 2000 (~90 s: loading and
 # uploading 600k splats under valgrind); docs/robustness.md records its result.
 # Usage: sh tests/test_valgrind.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
@@ -93,13 +94,26 @@ printf 'rouge-strokes 1\nview yaw=0 pitch=0 zoom=1 fov=30 size=48x48\n%s\ncosmet
 s 0.02 24.0 24.0 0.7
 s 0.04 28.0 24.0 0.9" >"$tmp/short.strokes"
 memcheck valgrind_pack_info 0 "$pack" --info "$tmp/face.rsf"
-# One render does it all (each GL process costs ~20 s under valgrind, mostly llvmpipe compiling shaders):
-# load a look made natively, replay the stroke on top (ID-buffer picks), save the look, mobile pipeline.
+# One render does it all: load a look made natively, replay the stroke on top (ID-buffer picks), save the
+# look, mobile pipeline.
 "$rouge" render "$tmp/face.rsf" --size 48x48 --strokes "$tmp/short.strokes" --save-look "$tmp/first.look" \
     -o "$tmp/first.png" >/dev/null 2>&1
-memcheck valgrind_render_loads_a_look_paints_and_saves 0 "$rouge" render "$tmp/face.rsf" --size 48x48 \
-    --pipeline mobile --look "$tmp/first.look" --strokes "$tmp/short.strokes" --save-look "$tmp/second.look" \
-    -o "$tmp/painted.png"
+set -- "$rouge" render "$tmp/face.rsf" --size 48x48 --pipeline mobile --look "$tmp/first.look" \
+    --strokes "$tmp/short.strokes" --save-look "$tmp/second.look" -o "$tmp/painted.png"
+if selected valgrind_render_loads_a_look_paints_and_saves; then
+    # About half of this render's time under memcheck was llvmpipe compiling its shaders (LLVM itself
+    # run under memcheck, ~50 CPU-s). The same command runs first under valgrind's no-op tool (a few
+    # times native speed, not ~40) with a private Mesa shader cache, and memcheck reads every program
+    # back from it: Mesa's cache is keyed by the CPU valgrind shows, so only a run under valgrind can fill
+    # it, and one of the same command finds every program memcheck's run will ask for, so memcheck never
+    # writes an entry (that path trips on Mesa's padding bytes; see above). rouge's code runs the same.
+    (
+        unset MESA_SHADER_CACHE_DISABLE MESA_GLSL_CACHE_DISABLE
+        export MESA_SHADER_CACHE_DIR="$tmp/shader-cache"
+        valgrind --tool=none --quiet --log-file="$out/warm-shaders.log" "$@" >/dev/null 2>&1
+        memcheck valgrind_render_loads_a_look_paints_and_saves 0 "$@"
+    )
+fi
 memcheck valgrind_imgdiff 0 "$imgdiff" $fx/image/a_8x8.png $fx/image/b_8x8_one_pixel_rgba.png --diff "$tmp/d.png"
 
 # Error paths: every early return frees what it allocated.

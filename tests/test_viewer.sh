@@ -4,7 +4,8 @@
 # changes the painted area and nothing else; undo restores the picture exactly; a bad face file exits
 # with one clear line; a bad file dropped on the window leaves the face as it was.
 # Usage: sh tests/test_viewer.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
-# RS_TEST_FACE overrides the face (default assets/face.rsf).
+# RS_TEST_FACE overrides the face (default assets/face.rsf); RS_VIEWER_SIZE the window (default 400x300: any
+# 4:3 size up to 800x600; the pixels drawn are most of this script's time).
 build=${1:-build}
 [ $# -gt 0 ] && shift
 filters="$*"
@@ -60,16 +61,37 @@ while [ ! -e "/tmp/.X11-unix/X$d" ] && [ $i -lt 50 ]; do sleep 0.1; i=$((i + 1))
 [ -e "/tmp/.X11-unix/X$d" ] || skip_all "Xvfb :$d did not start ($(head -c 200 "$out/xvfb.log"))"
 export DISPLAY=":$d" LIBGL_ALWAYS_SOFTWARE=1
 
-# The window is 800x600 at (0, 0) (no window manager). The face's forehead lies around (400, 150) at the
-# default camera; the toolbar covers the edges, so comparisons stay inside the free middle.
+# The window sits at (0, 0) (no window manager). Every coordinate below is written for an 800x600 window
+# and scaled to the real one by sc (event scripts) and px (xdotool): below 800x600 points the viewer scales
+# its whole UI with the window (VW_UI_DESIGN_W/H), and the face scales with the window's height, so at any
+# 4:3 size the same point lands on the same place of face or UI. At 800x600 the face's forehead lies around
+# (400, 150) at the default camera; the toolbar covers the edges, so comparisons stay inside the free middle.
+size=${RS_VIEWER_SIZE:-400x300}
+W=${size%x*} H=${size#*x}
+case "$W:$H" in *[!0-9:]*|:*|*:) echo "test_viewer.sh: RS_VIEWER_SIZE must be WxH, got '$size'" >&2; exit 1 ;; esac
+[ $((W * 3)) -eq $((H * 4)) ] && [ "$W" -le 800 ] || { echo "test_viewer.sh: RS_VIEWER_SIZE must be 4:3, at most 800x600" >&2; exit 1; }
+# sc: an event script on stdin, its coordinates (move, click, drag, screenshot regions) scaled to the window.
+sc() {
+    awk -v k="$W" 'BEGIN { k /= 800 }
+        $1 == "move" || $1 == "click" { $2 *= k; $3 *= k }
+        $1 == "drag" { $2 *= k; $3 *= k; $4 *= k; $5 *= k }
+        $1 == "screenshot" && NF == 6 { for (i = 3; i <= 6; i++) $i = int($i * k + 0.5) }
+        { print }'
+}
+# px V: one coordinate scaled to the window (whole pixels, for xdotool).
+px() { awk -v v="$1" -v w="$W" 'BEGIN { printf "%d", v * w / 800 + 0.5 }'; }
 # In: a box around the stroke. Out: three boxes around it that the brush cannot reach.
 IN="330 105 140 90"
 OUT1="80 260 630 150"
 OUT2="80 80 220 170"
 OUT3="500 80 210 170"
+# Checks of input and UI draw a 20000-splat prefix of the face (each full-quality frame costs about half
+# the 100000's); those about the picture itself (S at full quality, the window against rouge render, the
+# streamed file) draw 100000.
+ui_splats=20000 face_splats=100000
 # Every run keeps its looks in the test's own library (never the user's ~/.local/share/rouge/looks).
 view() {
-    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/looks" "$@"
+    timeout 180 "$rouge" view "$face" --size "$size" --max-splats "$ui_splats" --looks "$out/looks" "$@"
 }
 
 # shots PREFIX: screenshot commands for the in/out regions (the pointer parked on the swatch sheet, so
@@ -113,10 +135,18 @@ check_stroke() {
     fi
 }
 
+# One session for six checks: the loading screens, a stroke, undo, a look saved and loaded, the region
+# brush (after a clear, on the bare face again) and the smudge tool; the recording of all of it replays.
+sm="$out/smudge"
 if selected viewer_script_stroke_changes_only_the_painted_area || selected viewer_undo_restores_the_picture_exactly ||
-    selected viewer_look_saved_and_loaded_renders_the_same || selected viewer_records_a_replayable_stroke_file; then
-    rm -rf "$out/rec.strokes" "$out/looks"
+    selected viewer_look_saved_and_loaded_renders_the_same || selected viewer_records_a_replayable_stroke_file ||
+    selected viewer_region_brush_keeps_lipstick_on_the_lips ||
+    selected viewer_loading_reports_the_first_frame_stages_and_j_smudges; then
+    rm -rf "$out/rec.strokes" "$out/looks" "$sm"
+    mkdir -p "$sm"
     {
+        echo "loaded"
+        echo "state $sm/s0.txt"   # the loading screens (viewer_loading_reports_the_first_frame_stages_...)
         echo "key i"          # HUD off: its numbers change from frame to frame
         shots before
         echo "key p"          # paint mode
@@ -133,10 +163,33 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
         echo "key ctrl+o"
         echo "key enter"      # the library's newest look
         shots reloaded
+        # The region brush: lipstick keeps to the lips by default (K, on since above, goes off), so a
+        # stroke over the forehead paints nothing; with K (also the rail's region button) it paints.
+        echo "key delete"
+        shots kbefore
+        echo "key 9"
+        echo "key k"
+        echo "drag 370 150 430 150 30"
+        shots kmasked
+        echo "key k"
+        echo "drag 370 150 430 150 30"
+        shots kfree
+        # The smudge tool (J): a lipstick stripe dragged down carries its colour below it.
+        echo "drag 340 140 460 140 12"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $sm/a.png 330 100 140 130"
+        echo "key j"
+        echo "drag 400 140 400 215 12"
+        echo "move 400 580"
+        echo "idle"
+        echo "screenshot $sm/b.png 330 100 140 130"
+        echo "state $sm/s1.txt"
         echo "quit"
-    } >"$out/stroke.events"
+    } | sc >"$out/stroke.events"
     view --events "$out/stroke.events" --record "$out/rec.strokes" >"$out/script.log" 2>&1
     rc=$?
+    stroke_rc=$rc
     if selected viewer_script_stroke_changes_only_the_painted_area; then
         if [ $rc -ne 0 ]; then echo "FAIL - viewer_script_stroke_changes_only_the_painted_area: exit $rc: $(tail -c 300 "$out/script.log")"
         else cp "$out/script.log" "$out/viewer_script_stroke_changes_only_the_painted_area.log"
@@ -158,7 +211,7 @@ if selected viewer_script_stroke_changes_only_the_painted_area || selected viewe
         name=viewer_records_a_replayable_stroke_file
         if ! head -1 "$out/rec.strokes" 2>/dev/null | grep -q "^rouge-strokes 1"; then
             echo "FAIL - $name: $out/rec.strokes missing or not a stroke file"
-        elif ! timeout 120 "$rouge" render "$face" --strokes "$out/rec.strokes" --max-splats 100000 --pipeline mobile \
+        elif ! timeout 120 "$rouge" render "$face" --strokes "$out/rec.strokes" --max-splats "$ui_splats" --pipeline mobile \
             --size 320x240 -o "$out/replayed.png" >"$out/replay.log" 2>&1; then
             echo "FAIL - $name: replay failed: $(tail -c 300 "$out/replay.log")"
         else echo "ok - $name"; fi
@@ -182,21 +235,22 @@ if selected viewer_xdotool_stroke_changes_only_the_painted_area; then
             echo "wait-for $flag"
             shots xafter
             echo "quit"
-        } >"$out/xdo.events"
+        } | sc >"$out/xdo.events"
         view --events "$out/xdo.events" >"$out/$name.log" 2>&1 &
         pid=$!
         # Wait until the script has taken paint mode and lipstick (its state file), then stroke with the
         # real X pointer.
         i=0
         while [ ! -f "$out/xdo_ready.txt" ] && [ $i -lt 1200 ] && kill -0 $pid 2>/dev/null; do sleep 0.05; i=$((i + 1)); done
-        xdotool mousemove 370 150 mousedown 1 >/dev/null 2>&1
+        y=$(px 150)
+        xdotool mousemove "$(px 370)" "$y" mousedown 1 >/dev/null 2>&1
         x=370
         while [ $x -lt 430 ]; do
             x=$((x + 4))
-            xdotool mousemove $x 150 >/dev/null 2>&1
+            xdotool mousemove "$(px $x)" "$y" >/dev/null 2>&1
             sleep 0.02
         done
-        xdotool mouseup 1 mousemove 400 580 >/dev/null 2>&1
+        xdotool mouseup 1 mousemove "$(px 400)" "$(px 580)" >/dev/null 2>&1
         sleep 0.5
         touch "$flag"
         wait $pid
@@ -272,9 +326,9 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel + shade_sel)) -gt 0 ]; then
             echo "screenshot $out/dafter_all.png"
         fi
         if [ $reset_sel = 1 ]; then
-            # The sun dial sits at (698, 86) 84x84 on an 800x600 window (rs_ui_toolbar_layout_compute,
-            # scale 1): a drag on it moves the light (geared: 50 px drag = 0.42 of the dial), arrows orbit;
-            # `0` must bring back the picture as it started.
+            # The sun dial sits at (698, 86) 84x84 at 800x600 (rs_ui_toolbar_layout_compute, scale 1): a
+            # drag on it moves the light (geared: 50 px drag = 0.42 of the dial), arrows orbit; `0` must
+            # bring back the picture as it started.
             echo "move 400 580"
             echo "idle"
             echo "screenshot $out/r0before_face.png 80 80 630 330"
@@ -324,8 +378,8 @@ if [ $((drop_sel + reset_sel + zoom_sel + eye_sel + shade_sel)) -gt 0 ]; then
             echo "state $out/sh0.txt"
         fi
         echo "quit"
-    } >"$out/views.events"
-    timeout 180 "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" \
+    } | sc >"$out/views.events"
+    timeout 180 "$rouge" view "$face" --size "$size" --max-splats "$ui_splats" --looks "$out/shade_looks" \
         --events "$out/views.events" >"$out/views.log" 2>&1
     rc=$?
     views_rc=$rc
@@ -380,8 +434,8 @@ if selected viewer_s_saves_at_full_quality; then
     # (`frames`: an S in the frame right after the first export's was not taken; `idle` right after the
     # second Enter would not yet see its export waiting.)
     printf 'key p\nidle\ndrag 300 300 380 300 10\nkey s\nkey enter\nmove 400 580\nidle\nframes 1\nkey s\nkey enter\nframes 2\nidle\nquit\n' \
-        >"$out/s_shot.events"
-    (cd "$out/s_shot" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+        | sc >"$out/s_shot.events"
+    (cd "$out/s_shot" && timeout 180 "$abs_rouge" view "$abs_face" --size "$size" --max-splats "$face_splats" \
         --events "$abs_out/s_shot.events" >"$abs_out/s_shot.log" 2>&1)
     if [ ! -f "$out/s_shot/rouge-0001.png" ] || [ ! -f "$out/s_shot/rouge-0002.png" ]; then
         echo "FAIL - $name: no screenshot written ($(tail -c 200 "$out/s_shot.log"))"
@@ -398,12 +452,12 @@ if selected viewer_and_rouge_render_show_the_same_look; then
     name=viewer_and_rouge_render_show_the_same_look
     rm -rf "$out/same" && mkdir -p "$out/same"
     printf 'key i\nmove 400 580\nidle\nkey s\nkey enter\nidle\nkey p\nkey 9\ndrag 372 421 428 421 20\nmove 400 580\nidle\nkey s\nkey enter\nidle\nquit\n' \
-        >"$out/same.events"
-    (cd "$out/same" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+        | sc >"$out/same.events"
+    (cd "$out/same" && timeout 180 "$abs_rouge" view "$abs_face" --size "$size" --max-splats "$face_splats" \
         --events "$abs_out/same.events" --record "$abs_out/same/look.strokes" >"$abs_out/same.log" 2>&1)
     if [ ! -f "$out/same/rouge-0002.png" ] || [ ! -s "$out/same/look.strokes" ]; then
         echo "FAIL - $name: no screenshot or recording ($(tail -c 200 "$out/same.log"))"
-    elif ! timeout 180 "$rouge" render "$face" --strokes "$out/same/look.strokes" --size 800x600 --max-splats 100000 \
+    elif ! timeout 180 "$rouge" render "$face" --strokes "$out/same/look.strokes" --size "$size" --max-splats "$face_splats" \
         --pipeline mobile -o "$out/same/render.png" >"$out/same_render.log" 2>&1; then
         echo "FAIL - $name: rouge render failed: $(tail -c 300 "$out/same_render.log")"
     else
@@ -431,8 +485,8 @@ if selected viewer_streamed_face_draws_the_first_level_before_the_rest; then
         mkfifo "$out/stream.fifo"
         # The region above the loading line (spinner and text sit at the window's middle).
         printf 'key i\nscreenshot %s 80 80 630 170\nloaded\nscreenshot %s 80 80 630 170\nquit\n' \
-            "$out/stream_first.png" "$out/stream_full.png" >"$out/stream.events"
-        timeout 180 "$rouge" view - --size 800x600 --max-splats 100000 --events "$out/stream.events" \
+            "$out/stream_first.png" "$out/stream_full.png" | sc >"$out/stream.events"
+        timeout 180 "$rouge" view - --size "$size" --max-splats "$face_splats" --events "$out/stream.events" \
             <"$out/stream.fifo" >"$out/stream.log" 2>&1 &
         pid=$!
         {
@@ -461,24 +515,9 @@ if selected viewer_streamed_face_draws_the_first_level_before_the_rest; then
     fi
 fi
 if selected viewer_region_brush_keeps_lipstick_on_the_lips; then
-    # Lipstick stays on the lips by default: a stroke over the forehead paints nothing; with K (the brush
-    # may leave its region, also the rail's region button) the same stroke paints.
+    # (In the stroke session above.)
     name=viewer_region_brush_keeps_lipstick_on_the_lips
-    {
-        echo "key i"
-        shots kbefore
-        echo "key p"
-        echo "key 9"
-        echo "drag 370 150 430 150 30"
-        shots kmasked
-        echo "key k"
-        echo "drag 370 150 430 150 30"
-        shots kfree
-        echo "quit"
-    } >"$out/region.events"
-    view --events "$out/region.events" >"$out/region.log" 2>&1
-    rc=$?
-    if [ $rc -ne 0 ] || [ ! -f "$out/kfree_mid.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/region.log")"
+    if [ $stroke_rc -ne 0 ] || [ ! -f "$out/kfree_mid.png" ]; then echo "FAIL - $name: exit $stroke_rc: $(tail -c 300 "$out/script.log")"
     elif ! why=$(region_same kbefore kmasked in mid); then echo "FAIL - $name: lipstick painted the forehead: $why"
     elif ! region_changed kmasked kfree; then echo "FAIL - $name: with K the stroke did not paint"
     else echo "ok - $name"; fi
@@ -533,7 +572,7 @@ if selected viewer_look_library_saves_refuses_clashes_loads_compares_deletes; th
         echo "click 192 112"            # ... deletes
         echo "key esc"
         echo "quit"
-    } >"$out/library.events"
+    } | sc >"$out/library.events"
     view --events "$out/library.events" >"$out/library.log" 2>&1
     rc=$?
     if [ $rc -ne 0 ] || [ ! -f "$out/lsheet.png" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/library.log")"
@@ -557,8 +596,8 @@ if selected viewer_product_editor_paints_and_saves_a_custom_product; then
     printf '%s\n' 'key i' 'key 9' 'key c' 'key x' 'type b03050' 'key enter' 'key n' 'key n' 'key .' \
         'drag 372 421 428 421 20' 'move 400 580' 'idle' 'key s' 'key enter' 'idle' 'key ctrl+s' 'key backspace' 'key backspace' \
         'key backspace' 'key backspace' 'key backspace' 'key backspace' 'type Editor' 'key enter' 'idle' 'quit' \
-        >"$out/editor.events"
-    (cd "$out/editor" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 \
+        | sc >"$out/editor.events"
+    (cd "$out/editor" && timeout 180 "$abs_rouge" view "$abs_face" --size "$size" --max-splats "$face_splats" \
         --looks "$abs_out/editor/looks" --events "$abs_out/editor.events" >"$abs_out/editor.log" 2>&1)
     look="$out/editor/looks/Editor.look"
     line=$(grep '^cosmetic' "$look" 2>/dev/null | head -1)
@@ -567,7 +606,7 @@ if selected viewer_product_editor_paints_and_saves_a_custom_product; then
     elif ! echo "$line" | grep -q 'custom .*rgb=176,48,80 ' || ! echo "$line" | grep -q 'coat=1 ' ||
         ! echo "$line" | grep -Eq 'coverage=0\.(7|69999)'; then
         echo "FAIL - $name: the look does not carry the custom product: $line"
-    elif ! timeout 180 "$rouge" render "$face" --look "$look" --size 800x600 --max-splats 100000 --pipeline mobile \
+    elif ! timeout 180 "$rouge" render "$face" --look "$look" --size "$size" --max-splats "$face_splats" --pipeline mobile \
         --zoom 0.85 -o "$out/editor/render.png" >"$out/editor_render.log" 2>&1; then
         echo "FAIL - $name: rouge render --look failed: $(tail -c 300 "$out/editor_render.log")"
     else
@@ -576,15 +615,15 @@ if selected viewer_product_editor_paints_and_saves_a_custom_product; then
         else echo "FAIL - $name: window vs rouge render --look: ${same:-error} of pixels over 8 ($out/editor)"; fi
     fi
 fi
-if selected viewer_slow_frames_lose_no_input_and_orbit_by_the_drag; then
+if selected viewer_slow_frames_lose_no_input_and_orbit_by_the_drag || selected viewer_product_editor_keeps_the_face_at_full_quality; then
     # Issue 21: under slow frames (0.4 s each, `slow`) events keep arriving as a hand makes them, many per
-    # frame. A 60-point drag in view mode must turn the camera by exactly 60 * 0.35 deg of yaw and no
-    # pitch, although the quality ladder lowers the render scale during it (once the drag was measured
+    # frame. A 60-point drag (at 800x600, scaled with the window) must turn the camera by 0.35 deg of yaw a
+    # point and no pitch, although the quality ladder lowers the render scale during it (once the drag was measured
     # across two pixel scales and threw the camera under the chin); a quick flick of the sun dial and
     # quick clicks on the product editor's hue strip and colour square, all in a frame or two with the
     # key that opens the editor, must all act; no event is lost. Layout at 800x600, scale 1: the dial at
-    # (698, 86) 84x84 (geared: the sun moves by drag / 120 of the radius); the editor's colour square at
-    # (422, 170) 150x100, its hue strip at (422, 278) 150x16.
+    # (698, 86) 84x84 (geared: the sun moves by drag / 120 of the radius, both scaled with the UI: the same
+    # sun at any size); the editor's colour square at (422, 170) 150x100, its hue strip at (422, 278) 150x16.
     name=viewer_slow_frames_lose_no_input_and_orbit_by_the_drag
     st="$out/slow"
     {
@@ -604,15 +643,27 @@ if selected viewer_slow_frames_lose_no_input_and_orbit_by_the_drag; then
         echo "click 512 286"               # hue 216
         echo "state ${st}2.txt"
         echo "slow 0"
+        # viewer_product_editor_keeps_the_face_at_full_quality (below): with the editor open, a drag in its
+        # colour square over slow frames.
+        echo "move 400 580"
+        echo "idle"
+        echo "state $out/ed0.txt"
+        echo "slow 0.3"
+        echo "step 0.03"
+        echo "drag 450 200 540 250 30"   # the colour square at (422, 170) 150x100
+        echo "state $out/ed1.txt"
+        echo "slow 0"
         echo "quit"
-    } >"$out/slow.events"
+    } | sc >"$out/slow.events"
     view --events "$out/slow.events" >"$out/slow.log" 2>&1
     rc=$?
+    slow_rc=$rc
     val() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$st$1.txt" 2>/dev/null; }
-    if [ $rc -ne 0 ] || [ ! -f "${st}2.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/slow.log")"
-    elif ! awk -v y="$(val 1 yaw_deg)" -v p="$(val 1 pitch_deg)" -v y0="$(val 0 yaw_deg)" -v p0="$(val 0 pitch_deg)" \
-        'BEGIN { exit !(y - y0 > -21.01 && y - y0 < -20.99 && p - p0 > -0.01 && p - p0 < 0.01) }'; then
-        echo "FAIL - $name: a 60-point drag turned the camera by yaw $(val 1 yaw_deg), pitch $(val 1 pitch_deg) (want -21, 0)"
+    if ! selected "$name"; then :
+    elif [ $rc -ne 0 ] || [ ! -f "${st}2.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/slow.log")"
+    elif ! awk -v y="$(val 1 yaw_deg)" -v p="$(val 1 pitch_deg)" -v y0="$(val 0 yaw_deg)" -v p0="$(val 0 pitch_deg)" -v w="$W" \
+        'BEGIN { want = -60 * w / 800 * 0.35; exit !(y - y0 > want - 0.01 && y - y0 < want + 0.01 && p - p0 > -0.01 && p - p0 < 0.01) }'; then
+        echo "FAIL - $name: a $(px 60)-point drag turned the camera by yaw $(val 1 yaw_deg), pitch $(val 1 pitch_deg) (want $(px 60) * -0.35, 0)"
     elif ! val 1 render_scale_range | awk '{ exit !($1 < 1) }'; then
         echo "FAIL - $name: the render scale never dropped during the drag ($(val 1 render_scale_range)): proves nothing"
     elif ! val 2 light_dial | awk '{ exit !($1 > -0.427 && $1 < -0.407 && $2 > 0.223 && $2 < 0.243) }'; then
@@ -672,8 +723,8 @@ if selected viewer_compare_and_export_do_what_they_say; then
         echo "key enter"                 # and without the split: rouge-0002.png
         echo "idle"
         echo "quit"
-    } >"$d/cmp.events"
-    (cd "$d" && timeout 180 "$abs_rouge" view "$abs_face" --size 800x600 --max-splats 100000 --looks "$abs_out/cmp/looks" \
+    } | sc >"$d/cmp.events"
+    (cd "$d" && timeout 180 "$abs_rouge" view "$abs_face" --size "$size" --max-splats "$ui_splats" --looks "$abs_out/cmp/looks" \
         --events "$abs_out/cmp/cmp.events" >"$abs_out/cmp/cmp.log" 2>&1)
     rc=$?
     val() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$d/$1.txt" 2>/dev/null; }
@@ -696,29 +747,16 @@ if selected viewer_compare_and_export_do_what_they_say; then
 fi
 if selected viewer_product_editor_keeps_the_face_at_full_quality; then
     # Issue 21: dragging in the product editor's colour square (over several slow frames) changes no view:
-    # the face stays at full quality (it once dropped to a blocky preview while a widget was held).
+    # the face stays at full quality (it once dropped to a blocky preview while a widget was held). In the
+    # slow-frames session above, the editor open.
     name=viewer_product_editor_keeps_the_face_at_full_quality
-    {
-        echo "key i"
-        echo "key c"
-        echo "move 400 580"
-        echo "idle"
-        echo "state $out/ed0.txt"
-        echo "slow 0.3"
-        echo "step 0.03"
-        echo "drag 450 200 540 250 30"   # the colour square at (422, 170) 150x100
-        echo "state $out/ed1.txt"
-        echo "slow 0"
-        echo "quit"
-    } >"$out/edq.events"
-    view --events "$out/edq.events" >"$out/edq.log" 2>&1
-    rc=$?
+    rc=$slow_rc
     r0=$(awk '$1 == "editor_hsv" {print $3, $4}' "$out/ed0.txt" 2>/dev/null)
     r1=$(awk '$1 == "editor_hsv" {print $3, $4}' "$out/ed1.txt" 2>/dev/null)
     f=$(awk '$1 == "frame" {print $2}' "$out/ed1.txt" 2>/dev/null)
     f0=$(awk '$1 == "frame" {print $2}' "$out/ed0.txt" 2>/dev/null)
     range=$(awk '$1 == "render_scale_range" {print $2, $3}' "$out/ed1.txt" 2>/dev/null)
-    if [ $rc -ne 0 ] || [ -z "$r1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/edq.log")"
+    if [ $rc -ne 0 ] || [ -z "$r1" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/slow.log")"
     elif [ "$r0" = "$r1" ] || [ $((f - f0)) -lt 3 ]; then echo "FAIL - $name: the drag did not act over several frames ($r0 -> $r1, $((f - f0)) frames)"
     elif [ "$range" != "1.000 1.000" ]; then echo "FAIL - $name: the face was drawn at render scales $range while the colour moved"
     else echo "ok - $name"; fi
@@ -729,9 +767,9 @@ if selected viewer_my_shades_persist_and_can_be_picked_again; then
     # (the row's first swatch at (422, 408) 24x28 on an 800x600 window) paints with it again.
     # The first session is the shared launch above (its eyedropper, then Enter); this is the next one.
     name=viewer_my_shades_persist_and_can_be_picked_again
-    printf 'key c\nidle\nstate %s\nclick 434 422\nidle\nstate %s\nquit\n' "$out/sh1.txt" "$out/sh2.txt" >"$out/shade1.events"
+    printf 'key c\nidle\nstate %s\nclick 434 422\nidle\nstate %s\nquit\n' "$out/sh1.txt" "$out/sh2.txt" | sc >"$out/shade1.events"
     rc0=${views_rc:-1}
-    "$rouge" view "$face" --size 800x600 --max-splats 100000 --looks "$out/shade_looks" --events "$out/shade1.events" \
+    "$rouge" view "$face" --size "$size" --max-splats "$ui_splats" --looks "$out/shade_looks" --events "$out/shade1.events" \
         >"$out/shade1.log" 2>&1
     rc1=$?
     sv() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$out/sh$1.txt" 2>/dev/null; }
@@ -753,7 +791,7 @@ if selected viewer_recording_on_a_full_disk_keeps_the_old_file; then
     if mount -t tmpfs -o size=64k tmpfs "$out/full" 2>/dev/null; then
         printf 'old recording' >"$out/full/rec.strokes"
         dd if=/dev/zero of="$out/full/filler" bs=1k count=64 >/dev/null 2>&1
-        printf 'key i\nkey p\nkey 9\nkey k\nidle\ndrag 370 150 430 150 10\nidle\nquit\n' >"$out/full.events"
+        printf 'key i\nkey p\nkey 9\nkey k\nidle\ndrag 370 150 430 150 10\nidle\nquit\n' | sc >"$out/full.events"
         view --record "$out/full/rec.strokes" --events "$out/full.events" >"$out/full.log" 2>&1
         rc=$?
         left=$(ls "$out/full" | grep -c '\.tmp\.')
@@ -770,19 +808,16 @@ fi
 if selected viewer_loading_reports_the_first_frame_stages_and_j_smudges; then
     # Loading shows real progress: the face is made with its first frame, and the loading screen is drawn
     # at each stage create reports (ten: reading .. lighting, the frame's five, done), fractions never
-    # going back. Then the smudge tool (J): a lipstick stripe dragged down carries its colour below it.
+    # going back. Then the smudge tool (J): a lipstick stripe dragged down carries its colour below it. Both
+    # in the stroke session above (the face's first load; the stripe last, lipstick anywhere).
     name=viewer_loading_reports_the_first_frame_stages_and_j_smudges
-    d="$out/smudge"
-    mkdir -p "$d"
-    printf 'loaded\nstate %s/s0.txt\nkey p\nkey 9\nkey k\ndrag 340 140 460 140 12\nmove 400 580\nidle\nscreenshot %s/a.png 330 100 140 130\nkey j\ndrag 400 140 400 215 12\nmove 400 580\nidle\nscreenshot %s/b.png 330 100 140 130\nscreenshot %s/far.png 80 260 630 150\nstate %s/s1.txt\nquit\n' \
-        "$d" "$d" "$d" "$d" "$d" >"$d/smudge.events"
-    view --events "$d/smudge.events" >"$d/smudge.log" 2>&1
-    rc=$?
+    d="$sm"
+    rc=$stroke_rc
     sval() { awk -v k="$2" '$1 == k { $1 = ""; print substr($0, 2) }' "$d/$1.txt" 2>/dev/null; }
     stages=$(sval s0 loading_stages)
     # Below the stripe (y 160..215 of the window: rows 60..115 of the shots), the smudge's column changed.
     below=$("$imgdiff" "$d/a.png" "$d/b.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
-    if [ $rc -ne 0 ] || [ ! -f "$d/s1.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$d/smudge.log")"
+    if [ $rc -ne 0 ] || [ ! -f "$d/s1.txt" ]; then echo "FAIL - $name: exit $rc: $(tail -c 300 "$out/script.log")"
     elif [ "$(sval s0 loading_screens)" != 10 ] ||
         ! echo "$stages" | awk -F';' '{
             want = "reading the face|uploading and compiling|makeup layer|lighting|shadow map|visibility|attributes|light and diffusion|composite|done"
