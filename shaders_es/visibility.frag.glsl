@@ -24,10 +24,12 @@ void main()
     float l;
     rs_pixel_ray(gl_FragCoord.xy, o, d);
     if (!rs_ray_disk(o, d, v_c, v_n, v_r, u_coverage, q, l)) discard;
+#ifndef RS_SHADOW
     // The rim beyond the disk (l > 1, drawn only to close sampling gaps) goes 2 eps further back: on a
     // concave crease a tangent disk's rim stands in front of the neighbouring surface, and must not
     // hide it (its normal is wrong there); in a gap, nothing else is in front of it anyway.
     gl_FragDepth = rs_depth_of(q + d * (l > 1.0 ? 3.0 * u_eps : u_eps));
+#endif
 #ifdef RS_PICK
     o_id = v_id;
 #endif
