@@ -17,14 +17,21 @@ flat in float v_r;
 flat in uint v_id;
 layout(location = 0) out uint o_id;
 #endif
+#ifdef RS_SHADOW
+in vec2 v_disk;
+#endif
 
 void main()
 {
+#ifdef RS_SHADOW
+    // The shadow map draws each disk's own quad (orthographic): the rasteriser gives the plane's depth, and
+    // the ray meets the plane where the interpolated disk coordinate says.
+    if (dot(v_disk, v_disk) > 1.0) discard;
+#else
     vec3 o, d, q;
     float l;
     rs_pixel_ray(gl_FragCoord.xy, o, d);
     if (!rs_ray_disk(o, d, v_c, v_n, v_r, u_coverage, q, l)) discard;
-#ifndef RS_SHADOW
     // The rim beyond the disk (l > 1, drawn only to close sampling gaps) goes 2 eps further back: on a
     // concave crease a tangent disk's rim stands in front of the neighbouring surface, and must not
     // hide it (its normal is wrong there); in a gap, nothing else is in front of it anyway.

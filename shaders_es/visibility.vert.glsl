@@ -19,6 +19,9 @@ flat out float v_r;
 #ifdef RS_PICK
 flat out uint v_id;
 #endif
+#ifdef RS_SHADOW
+out vec2 v_disk;  // the fragment's position in the disk's plane, in u_coverage radii from its centre
+#endif
 
 void main()
 {
@@ -44,6 +47,7 @@ void main()
     // 1.01: the inscribed disk's rim stays strictly inside the square.
     vec3 t1 = normalize(abs(n.x) < 0.7 ? vec3(0.0, n.z, -n.y) : vec3(n.y, -n.x, 0.0));
     vec2 corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1)) * 2.0 - 1.0;
+    v_disk = corner * 1.01;
     vec3 p = c + (corner.x * t1 + corner.y * cross(n, t1)) * (v_r * u_coverage * 1.01);
     gl_Position = u_proj * vec4(p, 1.0);
 #else
