@@ -17,14 +17,14 @@ flat in float v_r;
 flat in uint v_id;
 layout(location = 0) out uint o_id;
 #endif
-#ifdef RS_SHADOW
+#if defined(RS_SHADOW) && defined(RS_QUADS)
 in vec2 v_disk;
 #endif
 
 void main()
 {
-#ifdef RS_SHADOW
-    // The shadow map draws each disk's own quad (orthographic): the rasteriser gives the plane's depth, and
+#if defined(RS_SHADOW) && defined(RS_QUADS)
+    // The shadow map's quads are the disks' own (visibility.vert.glsl) (orthographic): the rasteriser gives the plane's depth, and
     // the ray meets the plane where the interpolated disk coordinate says.
     if (dot(v_disk, v_disk) > 1.0) discard;
 #else

@@ -1,9 +1,6 @@
 // render_shadow.c — stage 1, the shadow map (paper Fig. 2): the splats' depth seen from the key light,
-// an orthographic frustum fitted to the cloud's bounding sphere, drawn with the visibility pass's program
-// (RS_SHADOW): each splat an instanced quad in its disk's plane, so the rasteriser interpolates the disk's
-// depth (no gl_FragDepth write: early depth test) and an oblique disk costs cos(theta) of a sprite's
-// texels; the fragment shader keeps the exact ray-disk coverage. On llvmpipe this made the 4096^2 map
-// ~5x cheaper than ray-disk depth over point sprites, the same map to float rounding. Lookups (shaders_es/shadow_lookup.glsl) compare each PCF tap against the receiver's
+// an orthographic frustum fitted to the cloud's bounding sphere, drawn with the visibility pass's ray-disk
+// shader (no push). Lookups (shaders_es/shadow_lookup.glsl) compare each PCF tap against the receiver's
 // own plane (receiver-plane depth bias, no normal offset) on a turned 4x4 grid of hardware 2x2 PCF. The
 // map only depends on the light and the LOD, so it is cached across camera moves, one per pipeline (the
 // mobile one at a quarter of the resolution, from the mobile LOD prefix).
@@ -94,9 +91,11 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
     glm_mat4_inv(proj, inv_proj);
     glm_mat4_mul(proj, view, m->vp);
     if (!cached) {
-        // Always instanced quads, each in its disk's plane (visibility.vert.glsl, RS_SHADOW).
+        // Instanced quads, each in its disk's plane (visibility.vert.glsl RS_SHADOW: rasterised depth, early
+        // depth test; ~7x cheaper on llvmpipe, the same map to rounding), unless points are asked for.
         GLuint prog;
-        res = rs_render_program(r, RS_PROG_SHADOW, true, &prog, err);
+        bool quads = f->view.prim != RS_PRIM_POINTS;
+        res = rs_render_program(r, RS_PROG_SHADOW, quads, &prog, err);
         if (res != RS_OK) return res;
         glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
         glViewport(0, 0, m->size, m->size);
@@ -110,7 +109,7 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
         rs_render_splat_uniforms(prog, view, proj, inv_proj, m->size, m->size, false, scale, -0.3f,
                                  r->caps.point_size_max);
         glUniform1f(rs_uloc(prog, "u_eps"), 0.0f);
-        rs_render_draw_splats(r, count, true);
+        rs_render_draw_splats(r, count, quads);
         memcpy(m->key, key, sizeof key);
         m->radius = r->radius_median * scale;
     }
