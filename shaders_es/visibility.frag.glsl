@@ -17,9 +17,17 @@ flat in float v_r;
 flat in uint v_id;
 layout(location = 0) out uint o_id;
 #endif
+#if defined(RS_SHADOW) && defined(RS_QUADS)
+in vec2 v_disk;
+#endif
 
 void main()
 {
+#if defined(RS_SHADOW) && defined(RS_QUADS)
+    // The shadow map's quads are the disks' own (visibility.vert.glsl) (orthographic): the rasteriser gives the plane's depth, and
+    // the ray meets the plane where the interpolated disk coordinate says.
+    if (dot(v_disk, v_disk) > 1.0) discard;
+#else
     vec3 o, d, q;
     float l;
     rs_pixel_ray(gl_FragCoord.xy, o, d);
@@ -28,6 +36,7 @@ void main()
     // concave crease a tangent disk's rim stands in front of the neighbouring surface, and must not
     // hide it (its normal is wrong there); in a gap, nothing else is in front of it anyway.
     gl_FragDepth = rs_depth_of(q + d * (l > 1.0 ? 3.0 * u_eps : u_eps));
+#endif
 #ifdef RS_PICK
     o_id = v_id;
 #endif
