@@ -1,7 +1,8 @@
 #version 300 es
 // composite.frag.glsl — stage 5: normalises the accumulated attributes (albedo A, normal N, m, rho_s,
 // ambient occlusion, clear coat, flakes), evaluates the specular S per pixel (Kelemen/Szirmay-Kalos: the
-// shadowed key light, the unshadowed fill, the environment's prefiltered radiance), reads the diffuse D
+// shadowed key light, the unshadowed fill, the environment's prefiltered radiance less what the shadow
+// maps of its other lamps hide), reads the diffuse D
 // of stage 4, and composes F = A (D + S) (paper eq. 1) or F = A D + S, then adds the makeup's untinted
 // clear coat and its flakes; then exposure, the filmic curve (or a clamp) and the sRGB encoding. Also the
 // debug views (render.h rs_render_mode). The makeup's fine layer (narrow brushes) is composed here per
@@ -318,12 +319,17 @@ void main()
             float ndotv = dot(N, V);
             float so = ao * contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv))
                      * reflection_open(p, reflect(-V, N));
-            E += rs_env_irradiance(N) * ao;
+            vec3 vis = rs_env_lamp_visibility(p, N);
+            E += rs_env_irradiance(N) * ao + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
             Eb = rs_bounce(ao, A);
-            S += rs_env_specular(N, V, m, RS_F0_SKIN) * (rho_s * so);
-            if (coat > 0.0) C += rs_env_specular(N, V, mc, RS_F0_COAT) * so;
+            // The map's reflection less the lamps that this point's shadow maps hide.
+            S += max(rs_env_specular(N, V, m, RS_F0_SKIN) - rs_env_lamp_specular_hidden(N, V, m, RS_F0_SKIN, vis),
+                     vec3(0.0)) * (rho_s * so);
+            if (coat > 0.0)
+                C += max(rs_env_specular(N, V, mc, RS_F0_COAT) - rs_env_lamp_specular_hidden(N, V, mc, RS_F0_COAT, vis),
+                         vec3(0.0)) * so;
         }
         C *= coat;
         // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).

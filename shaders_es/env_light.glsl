@@ -2,18 +2,21 @@
 // diffuse, the prefiltered radiance mip chain for the specular lobes (split sum: the radiance around the
 // mirror direction, prefiltered with the lobe's Beckmann roughness, times the lobe's directional albedo
 // from a lookup table; render_env.c). Directions arrive in view space and turn into the environment's
-// frame (the face frame, rotated by --env-rotate) through u_env_from_view.
+// frame (the face frame, rotated by --env-rotate) through u_env_from_view. The environment's other compact
+// lamps are lit exactly and shadow-mapped: shadow_lookup.glsl comes first.
 uniform float u_env_on;             // 0: no environment (key/fill/ambient only)
 uniform mat3 u_env_from_view;
 uniform vec3 u_env_sh[9];           // irradiance / pi, times the environment's exposure normalisation
 uniform vec3 u_env_lamp_dir[3];     // the other compact lamps (render_env.c find_lamps): taken out of the
-uniform vec3 u_env_lamp_color[3];   // SH, lit exactly (unshadowed, diffuse only); colour 0 when unused
+uniform vec3 u_env_lamp_color[3];   // SH, lit exactly and shadowed; colour 0 when unused; the map keeps
+uniform float u_env_lamp_widen[3];  // them for the reflections; half their angular radius, radians
 uniform highp sampler2D u_env_map;  // RGB9E5 equirect, level k prefiltered with roughness u_env_m[k]
 uniform float u_env_m[8];
 uniform int u_env_levels;
 uniform float u_env_scale;          // exposure normalisation of the map (the SH carry theirs)
 uniform highp sampler2D u_spec_lut; // (N.V, m) -> (A, B): the lobe's directional albedo is F0 A + B
 
+// The SH's irradiance (the environment without its key light and lamps) at view-space normal n_view.
 vec3 rs_env_irradiance(vec3 n_view)
 {
     vec3 n = u_env_from_view * n_view;
@@ -23,8 +26,25 @@ vec3 rs_env_irradiance(vec3 n_view)
            + u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
            + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
            + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y));
-    for (int i = 0; i < 3; i++) e += u_env_lamp_color[i] * max(dot(n, u_env_lamp_dir[i]), 0.0);
     return max(e, vec3(0.0));
+}
+
+// How much of each lamp reaches the view-space point p with normal n_view (its shadow map; 1 unshadowed).
+vec3 rs_env_lamp_visibility(vec3 p, vec3 n_view)
+{
+    vec3 vis = vec3(1.0);
+    for (int i = 0; i < 3; i++)
+        if (dot(u_env_lamp_color[i], u_env_lamp_color[i]) > 0.0) vis[i] = rs_lamp_shadow(i, p, n_view);
+    return vis;
+}
+
+// The lamps' irradiance at view-space normal n_view, lamp i seen by vis[i]. Not times the ambient
+// occlusion, as the key light is not: the shadow map is their visibility.
+vec3 rs_env_lamp_irradiance(vec3 n_view, vec3 vis)
+{
+    vec3 n = u_env_from_view * n_view, e = vec3(0.0);
+    for (int i = 0; i < 3; i++) e += u_env_lamp_color[i] * (max(dot(n, u_env_lamp_dir[i]), 0.0) * vis[i]);
+    return e;
 }
 
 // Fractional mip level for roughness m: piecewise linear between the levels' roughnesses.
@@ -104,4 +124,18 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     }
     vec3 L = wsum > 0.0 ? sum / wsum : vec3(0.0);
     return L * rs_env_lobe_albedo(ndotv, m, f0);
+}
+
+// The share of rs_env_specular that the lamps hidden from this point (1 - vis) would reflect: each lamp as
+// the key light is drawn, a directional light whose angular size widens the lobe (roughness in
+// quadrature). The map keeps the lamps, so their shadows take this much out of its reflection.
+vec3 rs_env_lamp_specular_hidden(vec3 N_view, vec3 V_view, float m, float f0, vec3 vis)
+{
+    vec3 N = u_env_from_view * N_view, V = u_env_from_view * V_view, s = vec3(0.0);
+    for (int i = 0; i < 3; i++) {
+        if (vis[i] >= 1.0) continue;
+        float w = u_env_lamp_widen[i];
+        s += u_env_lamp_color[i] * (rs_ksk_lobe(N, u_env_lamp_dir[i], V, sqrt(m * m + w * w), f0) * (1.0 - vis[i]));
+    }
+    return s;
 }

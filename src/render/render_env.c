@@ -104,7 +104,8 @@ static int cmp_float(const void *a, const void *b)
 // over the surround, (1/pi) sum excess dw at the excess-weighted mean direction. A lamp that carries less
 // than 5 % of the map's mean irradiance is not worth it and ends the search. Each one's SH projection
 // (a directional light of colour c: sh_k = pi a_l c Y_k(d), a_l = 1, 2/3, 1/4) leaves the SH, and the
-// shader adds it exactly (env_light.glsl). The map itself keeps them: the specular reflects them.
+// shader adds it exactly, shadow-mapped (env_light.glsl, render_shadow.c). The map itself keeps them: the
+// specular reflects them, less what their shadows hide (their angular size widens that share's lobe).
 static void find_lamps(const rs_env *env, rs_render_env *e)
 {
     const rs_env_level *lv = &env->levels[0];
@@ -146,7 +147,7 @@ static void find_lamps(const rs_env *env, rs_render_env *e)
             }
         }
         for (int q = 0; q < 3; q++) ring[q] /= RS_MAX(ring_sr, 1e-12);
-        double col[3] = {0, 0, 0}, d[3] = {0, 0, 0};
+        double col[3] = {0, 0, 0}, d[3] = {0, 0, 0}, lsum = 0;
         for (size_t t = 0; t < n; t++) {
             float c = pd[0] * dir[3 * t] + pd[1] * dir[3 * t + 1] + pd[2] * dir[3 * t + 2];
             if (c < cos_region || lum[t] <= thr) continue;
@@ -158,6 +159,7 @@ static void find_lamps(const rs_env *env, rs_render_env *e)
             }
             lum[t] = LUM(rgb + 3 * t);
             double le = LUM(ex) * dw;
+            lsum += le;
             for (int q = 0; q < 3; q++) d[q] += le * dir[3 * t + q];
         }
         lum[peak] = 0;  // taken, whatever its region held
@@ -170,6 +172,9 @@ static void find_lamps(const rs_env *env, rs_render_env *e)
         for (int b = 0; b < 9; b++)
             for (int q = 0; q < 3; q++) e->sh[b][q] -= (float)(PI * band[b] * col[q] * y[b]);
         for (int q = 0; q < 3; q++) e->lamp_dir[k][q] = ld[q], e->lamp_color[k][q] = (float)col[q];
+        // Its angular radius as rouge-env measures the key's (a uniform disc's, sqrt(2 <theta^2>)), about
+        // the mean direction: <theta^2> ~ 2 (1 - <cos theta>), and <cos theta> = |d| / sum of the weights.
+        e->lamp_angle[k] = 2.0f * sqrtf((float)RS_MAX(1.0 - dl / RS_MAX(lsum, 1e-30), 0.0));
     }
 done:
     free(rgb);
@@ -296,6 +301,9 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
         for (int c = 0; c < 3; c++) lamp[k][c] = r->env.lamp_color[k][c] * e;
     glUniform3fv(rs_uloc(prog, "u_env_lamp_dir"), RS_ENV_LAMPS, &r->env.lamp_dir[0][0]);
     glUniform3fv(rs_uloc(prog, "u_env_lamp_color"), RS_ENV_LAMPS, &lamp[0][0]);
+    float widen[RS_ENV_LAMPS];
+    for (int k = 0; k < RS_ENV_LAMPS; k++) widen[k] = 0.5f * r->env.lamp_angle[k];
+    glUniform1fv(rs_uloc(prog, "u_env_lamp_widen"), RS_ENV_LAMPS, widen);
     glUniform1fv(rs_uloc(prog, "u_env_m"), RS_ENV_MAX_LEVELS, r->env.level_m);
     glUniform1i(rs_uloc(prog, "u_env_levels"), r->env.levels);
     glUniform1f(rs_uloc(prog, "u_env_scale"), r->env.scale * e);

@@ -49,6 +49,7 @@ enum {
     RS_UNIT_FINE,        // the fine layer's stamps and products (u_fine_data, RGBA32F)
     RS_UNIT_FINE_INDEX,  // the fine layer's grid: cells (start, count) then stamp lists (u_fine_index, R32UI)
     RS_UNIT_FINE_FIELD,  // the region masks' fields stacked along z (u_fine_field, R8 3D, linear)
+    RS_UNIT_LAMP_SHADOW, // the environment's other lamps' shadow maps, one atlas (u_lamp_shadow_map)
 };
 
 // The fine layer as uploaded (render_fine.c): per-pixel stamps over a model-space grid.
@@ -79,10 +80,11 @@ typedef struct rs_render_env {
     float light_dir[3];          // environment frame, towards the light
     float light_color[3];
     float light_angle;           // radians
-    // The environment's other compact lamps (render_env.c find_lamps): unshadowed, diffuse only, taken out
-    // of sh; colour 0 where unused.
+    // The environment's other compact lamps (render_env.c find_lamps): taken out of sh, lit exactly and
+    // shadow-mapped (render_shadow.c); colour 0 where unused. The map keeps them for the reflections.
     float lamp_dir[RS_ENV_LAMPS][3];
     float lamp_color[RS_ENV_LAMPS][3];
+    float lamp_angle[RS_ENV_LAMPS];  // angular radius, radians (their share of the reflections)
     int levels;
     float level_m[RS_ENV_MAX_LEVELS];
 } rs_render_env;
@@ -154,6 +156,18 @@ typedef struct rs_shadow_map {
     float radius;            // typical splat radius in the map, model units
 } rs_shadow_map;
 
+// The environment's other lamps' shadow maps (render_shadow.c): one depth atlas of 2 x 2 tiles, one per
+// lamp, shared by both pipelines (drawn from one LOD prefix whatever the pipeline), cached per lamp.
+#define RS_LAMP_SHADOW_SIZE 1024       // a tile
+#define RS_LAMP_SHADOW_SPLATS 160000   // the LOD prefix drawn (at most)
+typedef struct rs_lamp_shadows {
+    GLuint tex, fbo;
+    int size;                          // a tile's side
+    mat4 vp[RS_ENV_LAMPS];             // model -> the tile's light clip
+    float key[RS_ENV_LAMPS][6];        // as rs_shadow_map.key
+    float radius;                      // typical splat radius in the maps, model units
+} rs_lamp_shadows;
+
 typedef struct rs_frame {
     rs_view view;            // with zero fields replaced by their defaults
     rs_camera cam;
@@ -173,6 +187,12 @@ typedef struct rs_frame {
     mat4 shadow_matrix;      // view space -> light clip space
     mat3 shadow_normals;     // view-space normals -> light clip space (inverse transpose)
     float shadow_bias, shadow_texel;
+    bool lamp_shadows;                            // the environment's lamps shadow-mapped too
+    mat4 lamp_shadow_matrix[RS_ENV_LAMPS];        // view space -> a lamp's tile's light clip space
+    mat3 lamp_shadow_normals[RS_ENV_LAMPS];
+    vec3 lamp_shadow_dir[RS_ENV_LAMPS];           // view space, towards the lamp
+    float lamp_shadow_on[RS_ENV_LAMPS];           // 1: the lamp has a tile
+    float lamp_shadow_bias;
     float delta_weight[3];   // profile weight taken by per-pixel irradiance (stage 4's narrow Gaussians)
     bool env_on;             // lit by the renderer's environment (its light is then the key light)
     mat3 env_from_view;      // view-space directions -> the environment's frame (rotation included)
@@ -204,6 +224,7 @@ struct rs_renderer {
 
     // Shadow maps (reference, mobile), re-rendered only when the light or the LOD changes.
     rs_shadow_map shadow[2];
+    rs_lamp_shadows lamp_shadow;  // the environment's other lamps, both pipelines
     float area_total;           // the cloud's surface area, model units^2 (render_view.c face_pixels)
 
     // ID buffer, re-rendered only when the view changes.
