@@ -47,19 +47,18 @@ typedef struct measured {
     double delta_e, ratio[R_COUNT], band;
 } measured;
 static const measured was[] = {
-    // Measured with skin's specular at the physical strength (RS_RHO_S_PHYSICAL), Smith's masking-shadowing
-    // in the lobe and the environment's reflection blocked by the head itself (composite.frag.glsl). Studio
-    // front's band keeps the value from before the physical strength (0.876): its 1.156 is the side lamp's
-    // grazing sheen on the temple, not a goal met. Studio 3/4's ears (0.825, 0.923 before the physical
-    // strength) are outside the goal's range: rouge's ear is brighter than the path tracer's (issue 22).
-    {"studio", "front", 2.07, {1.102, 1.037, 0.984, 1.055, 0.978}, 0.876},
-    {"studio", "threequarter", 2.53, {1.116, 1.085, 0.825, 1.039, 0.974}, 0.893},
-    {"daylight", "front", 1.81, {1.008, 0.988, 0.991, 1.021, 1.002}, 0.886},
-    {"daylight", "threequarter", 1.58, {0.972, 1.008, 0.892, 0.990, 0.991}, 0.917},
-    {"office", "front", 2.10, {1.055, 0.974, 1.003, 0.964, 1.014}, 0.975},
-    {"office", "threequarter", 1.71, {1.058, 1.036, 1.015, 1.005, 1.047}, 0.993},
-    {"sunset", "front", 1.97, {1.107, 1.078, 1.040, 1.066, 1.113}, 0.886},
-    {"sunset", "threequarter", 1.70, {1.077, 1.103, 0.938, 1.028, 1.100}, 0.910},
+    // Measured with the environment's other lamps shadow-mapped (render_shadow.c; before: studio 2.07 / 2.53,
+    // daylight 1.81 / 1.58, office 2.10 / 1.71, sunset 1.97 / 1.70; studio 3/4's ears 0.825). Every view now
+    // meets the dE goal and is held to it. Studio front's band (1.023) is still lifted by the temple's
+    // sheen (the map's reflection of the side lamp), not a goal met: its guard keeps the value from before.
+    {"studio", "front", 1.91, {1.070, 1.020, 1.014, 1.039, 0.998}, 0.876},
+    {"studio", "threequarter", 1.86, {1.068, 1.065, 0.931, 1.026, 1.006}, 0.908},
+    {"daylight", "front", 1.67, {1.012, 0.990, 1.002, 1.019, 1.014}, 0.885},
+    {"daylight", "threequarter", 1.46, {0.987, 1.015, 0.932, 0.991, 1.010}, 0.919},
+    {"office", "front", 1.85, {1.043, 1.018, 1.022, 1.014, 1.026}, 0.974},
+    {"office", "threequarter", 1.59, {1.033, 1.062, 0.991, 0.998, 1.032}, 0.978},
+    {"sunset", "front", 1.78, {1.100, 1.056, 1.041, 1.059, 1.078}, 0.886},
+    {"sunset", "threequarter", 1.59, {1.091, 1.080, 0.967, 1.025, 1.073}, 0.914},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
@@ -417,8 +416,9 @@ static void test_view(void)
     char unmet[512] = "";
     size_t len = 0;
     if (r.delta_e > GOAL_DELTA_E) len += snprintf(unmet + len, sizeof unmet - len, " dE %.2f (goal <= 2.0)", r.delta_e);
-    held &= RS_CHECK(r.delta_e <= fmax(GOAL_DELTA_E, ref->delta_e + 0.25), "mean dE %.2f (was %.2f)", r.delta_e,
-                     ref->delta_e);
+    // A view that met the goal is held to it; one that did not, to what it measured.
+    double de_limit = ref->delta_e <= GOAL_DELTA_E ? GOAL_DELTA_E : ref->delta_e + 0.25;
+    held &= RS_CHECK(r.delta_e <= de_limit, "mean dE %.2f (was %.2f, limit %.2f)", r.delta_e, ref->delta_e, de_limit);
     for (int i = 0; i < R_COUNT; i++) {
         if (r.region_px[i] < 20) continue;  // not in view
         if (outside(r.ratio[i]) > 0) {
