@@ -47,11 +47,10 @@ typedef struct measured {
     double delta_e, ratio[R_COUNT], band;
 } measured;
 static const measured was[] = {
-    // Measured with the environment's other lamps shadowed (a map per lamp, render_shadow.c): every view's
-    // dE is now within the goal, every region ratio too (studio 3/4's ear: 0.825 before, the rear lamp's
-    // shadow of the ear was missing). Studio front's band keeps its value from before the physical specular
-    // strength (0.876): its 1.023 is the side lamp's grazing sheen on the temple lifting the band, while
-    // the dark line under the chin that holds the other views' bands below 1 is still there.
+    // Measured with the environment's other lamps shadow-mapped (render_shadow.c; before: studio 2.07 / 2.53,
+    // daylight 1.81 / 1.58, office 2.10 / 1.71, sunset 1.97 / 1.70; studio 3/4's ears 0.825). Every view now
+    // meets the dE goal and is held to it. Studio front's band (1.023) is still lifted by the temple's
+    // sheen (the map's reflection of the side lamp), not a goal met: its guard keeps the value from before.
     {"studio", "front", 1.91, {1.070, 1.020, 1.014, 1.039, 0.998}, 0.876},
     {"studio", "threequarter", 1.86, {1.068, 1.065, 0.931, 1.026, 1.006}, 0.908},
     {"daylight", "front", 1.67, {1.012, 0.990, 1.002, 1.019, 1.014}, 0.885},
@@ -417,8 +416,9 @@ static void test_view(void)
     char unmet[512] = "";
     size_t len = 0;
     if (r.delta_e > GOAL_DELTA_E) len += snprintf(unmet + len, sizeof unmet - len, " dE %.2f (goal <= 2.0)", r.delta_e);
-    held &= RS_CHECK(r.delta_e <= fmin(GOAL_DELTA_E, ref->delta_e + 0.25), "mean dE %.2f (was %.2f)", r.delta_e,
-                     ref->delta_e);
+    // A view that met the goal is held to it and to 0.25 over what it measured; one that did not, to the latter.
+    double de_limit = ref->delta_e <= GOAL_DELTA_E ? fmin(GOAL_DELTA_E, ref->delta_e + 0.25) : ref->delta_e + 0.25;
+    held &= RS_CHECK(r.delta_e <= de_limit, "mean dE %.2f (was %.2f, limit %.2f)", r.delta_e, ref->delta_e, de_limit);
     for (int i = 0; i < R_COUNT; i++) {
         if (r.region_px[i] < 20) continue;  // not in view
         if (outside(r.ratio[i]) > 0) {
