@@ -292,6 +292,7 @@ static void test_stroke_recording(void)
     rouge_face *g = NULL;
     rouge_view gv = small_view();
     gv.max_splats = 2000;
+    gv.pipeline = ROUGE_PIPELINE_MOBILE;  // about env_dir and the recorder, not the reference's ~3 CPU-s setup
     if (!RS_CHECK(rouge_face_create(&(rouge_face_desc){.path = FACE, .view = &gv, .env_dir = "assets/env"}, &g, &e) ==
                       ROUGE_OK,
                   "face with env_dir: %s", e.msg))
