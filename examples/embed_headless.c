@@ -13,7 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#define SIZE 512
+#define SIZE 256  // small enough for a test to run it in a second on a software GL
 
 // A context with no surface: Mesa's surfaceless platform (software or GPU), else the first EGL device
 // (NVIDIA without a display). rouge renders into its own framebuffers, so no surface is needed.
@@ -73,8 +73,8 @@ int main(int argc, char **argv)
     rouge_result r = rouge_face_render(face, &err);
     float lips_y = -1;
     rouge_pick pick;
-    for (int y = SIZE / 2; r == ROUGE_OK && y < SIZE && lips_y < 0; y += 4)
-        if (rouge_face_pick(face, SIZE / 2, (float)y, &pick) && pick.region == 4) lips_y = (float)y + 6;
+    for (int y = SIZE / 2; r == ROUGE_OK && y < SIZE && lips_y < 0; y += SIZE / 128)
+        if (rouge_face_pick(face, SIZE / 2, (float)y, &pick) && pick.region == 4) lips_y = (float)y + SIZE * 0.012f;
     if (r == ROUGE_OK && lips_y < 0) lips_y = SIZE * 0.62f;  // a face without a lips region
     if (r == ROUGE_OK) r = rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "lipstick_satin", .size = 0.05f}, &err);
     // One stroke: finger down left of the mouth centre, twenty moves to the right, finger up.

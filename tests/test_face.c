@@ -292,6 +292,7 @@ static void test_stroke_recording(void)
     rouge_face *g = NULL;
     rouge_view gv = small_view();
     gv.max_splats = 2000;
+    gv.pipeline = ROUGE_PIPELINE_MOBILE;  // about env_dir and the recorder, not the reference's ~3 CPU-s setup
     if (!RS_CHECK(rouge_face_create(&(rouge_face_desc){.path = FACE, .view = &gv, .env_dir = "assets/env"}, &g, &e) ==
                       ROUGE_OK,
                   "face with env_dir: %s", e.msg))
@@ -398,6 +399,7 @@ static void test_stream_previews_then_the_whole_face(void)
     RS_REQUIRE(rouge_stream_create("face", n, &s, &e) == ROUGE_OK, "%s", e.msg);
     rouge_view v = small_view();
     v.max_splats = 0;
+    v.pipeline = ROUGE_PIPELINE_MOBILE;  // about the stream, not the reference's fixed setup
     rouge_face *f = NULL;
     RS_CHECK(rouge_face_create(&(rouge_face_desc){.stream = s, .view = &v}, &f, &e) == ROUGE_ERR_ARG,
              "a face before any LOD level arrived: %s", e.msg);

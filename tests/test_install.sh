@@ -96,7 +96,7 @@ mkdir -p "$tmp/elsewhere"
 if [ -x "$tmp/embed_headless" ]; then
     if (cd "$tmp/elsewhere" && LD_LIBRARY_PATH="$root/usr/lib" "$tmp/embed_headless" "$root/usr/share/rouge/face.rsf" \
         "$tmp/eh.png") 2>"$tmp/err"; then
-        "$build/rouge" render "$root/usr/share/rouge/face.rsf" -o "$tmp/ref.png" --size 512x512 --pipeline mobile >/dev/null 2>&1
+        "$build/rouge" render "$root/usr/share/rouge/face.rsf" -o "$tmp/ref.png" --size 256x256 --pipeline mobile >/dev/null 2>&1
         "$build/rouge-imgdiff" "$tmp/ref.png" "$tmp/eh.png" --threshold 8 >"$tmp/m8" 2>&1
         "$build/rouge-imgdiff" "$tmp/ref.png" "$tmp/eh.png" --threshold 0 >"$tmp/m0" 2>&1
         f8=$(awk '$1 == "frac_over" {print $2}' "$tmp/m8")

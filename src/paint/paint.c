@@ -93,15 +93,17 @@ static void merge(rs_makeup_range *into, rs_makeup_range r)
 }
 
 // Keeps stamps spacing_rel of a brush radius apart on screen at the point being painted.
-static void update_spacing(rs_paint *p, const float pos[3])
+static void set_spacing(const rs_paint *p, rs_input *in, float size_rel, const float pos[3])
 {
     if (!p->picker.pixels_per_unit) return;
     float ppu = p->picker.pixels_per_unit(p->picker.user, pos);
-    float radius = rs_makeup_brush_radius(&rs_makeup_cloud(p->mk)->hdr, p->stroke_brush.size_rel);
-    if (isfinite(ppu) && ppu > 0.0f) rs_input_set_spacing(&p->input, p->spacing_rel * radius * ppu);
+    float radius = rs_makeup_brush_radius(&rs_makeup_cloud(p->mk)->hdr, size_rel);
+    if (isfinite(ppu) && ppu > 0.0f) rs_input_set_spacing(in, p->spacing_rel * radius * ppu);
 }
 
-static bool pick(rs_paint *p, float x, float y, uint32_t *idx, float hit[3])
+static void update_spacing(rs_paint *p, const float pos[3]) { set_spacing(p, &p->input, p->stroke_brush.size_rel, pos); }
+
+static bool pick(const rs_paint *p, float x, float y, uint32_t *idx, float hit[3])
 {
     return p->picker.pick(p->picker.user, x, y, idx, hit) && *idx < rs_makeup_count(p->mk);
 }
@@ -218,6 +220,41 @@ rs_result rs_paint_feed(rs_paint *p, const rs_input_event *ev, rs_paint_result *
     return r;
 }
 
+static rs_input_event replay_event(const rs_strokes_sample *sm, uint32_t n, uint32_t k, float sx, float sy)
+{
+    // The live sequence was down (first sample), moves, up (last sample).
+    uint32_t j = RS_MIN(k, n - 1);
+    rs_input_type type = k == 0 ? RS_INPUT_DOWN : k + 1 >= n + (n == 1) ? RS_INPUT_UP : RS_INPUT_MOVE;
+    return (rs_input_event){type, REPLAY_POINTER_ID, sm[j].x_px * sx, sm[j].y_px * sy, sm[j].pressure, sm[j].t_s};
+}
+
+// Stamps a replay would paint, counted without painting: the same input filter, picks and spacing as
+// rs_paint_feed (the ID buffer does not depend on the makeup), so a work bomb is refused before its work.
+// Stops once the cover bound is passed; *stamps is then the count the painting replay would fail at.
+static bool replay_within_bound(const rs_paint *p, const rs_strokes_sample *sm, uint32_t n, float sx, float sy,
+                                double q, uint32_t *stamps)
+{
+    rs_input in = p->input;
+    float size_rel = resolve_brush(&p->brush).size_rel;
+    rs_input_output out;
+    *stamps = 0;
+    for (uint32_t k = 0; k < n + (n == 1); k++) {
+        rs_input_event ev = replay_event(sm, n, k, sx, sy);
+        uint32_t idx;
+        float hit[3];
+        if (k == 0 && isfinite(ev.x_px) && isfinite(ev.y_px) && pick(p, ev.x_px, ev.y_px, &idx, hit))
+            set_spacing(p, &in, size_rel, hit);
+        rs_input_feed(&in, &ev, &out);
+        for (uint32_t i = 0; i < out.stamp_count; i++) {
+            if (!pick(p, out.stamps[i].x_px, out.stamps[i].y_px, &idx, hit)) continue;
+            ++*stamps;
+            set_spacing(p, &in, size_rel, hit);
+        }
+        if (*stamps * q * q > RS_PAINT_MAX_REPLAY_COVER) return false;
+    }
+    return true;
+}
+
 rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, uint32_t frame_w_px,
                           uint32_t frame_h_px, rs_paint_result *res, rs_error *err)
 {
@@ -239,22 +276,18 @@ rs_result rs_paint_replay(rs_paint *p, const rs_strokes *doc, uint32_t stroke, u
     double q = rs_paint_radius(p) / rs_makeup_cloud(p->mk)->hdr.face_height;
     float sx = (float)frame_w_px / (float)st->view.width_px, sy = (float)frame_h_px / (float)st->view.height_px;
     rs_result r = RS_OK;
-    // The live sequence was down (first sample), moves, up (last sample): feed exactly that.
+    // Each stamp costs the splats under it: a long zigzag with a wide brush is refused before it paints.
+    uint32_t counted;
+    if (!replay_within_bound(p, sm, st->sample_count, sx, sy, q, &counted))
+        r = rs_fail(err, RS_ERR_LIMIT, "stroke %u paints more than %.0f face areas (%u stamps)", stroke,
+                    RS_PAINT_MAX_REPLAY_COVER, counted);
     for (uint32_t k = 0; k < st->sample_count + (st->sample_count == 1) && r == RS_OK; k++) {
-        uint32_t j = RS_MIN(k, st->sample_count - 1);
-        rs_input_type type = k == 0 ? RS_INPUT_DOWN
-                           : k + 1 >= st->sample_count + (st->sample_count == 1) ? RS_INPUT_UP
-                                                                                 : RS_INPUT_MOVE;
-        rs_input_event ev = {type, REPLAY_POINTER_ID, sm[j].x_px * sx, sm[j].y_px * sy, sm[j].pressure, sm[j].t_s};
+        rs_input_event ev = replay_event(sm, st->sample_count, k, sx, sy);
         rs_paint_result one;
         r = rs_paint_feed(p, &ev, &one, err);
         merge(&res->dirty, one.dirty);
         res->stamps += one.stamps;
-        // Each stamp costs the splats under it: a long zigzag with a wide brush is bounded here, as it goes.
         res->cover = res->stamps * q * q;
-        if (r == RS_OK && res->cover > RS_PAINT_MAX_REPLAY_COVER)
-            r = rs_fail(err, RS_ERR_LIMIT, "stroke %u paints more than %.0f face areas (%u stamps)", stroke,
-                        RS_PAINT_MAX_REPLAY_COVER, res->stamps);
         res->misses += one.misses;
         res->stroke_begin |= one.stroke_begin;
         res->stroke_end |= one.stroke_end;
