@@ -16,10 +16,10 @@ jobs=${RS_TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 
 # Run alone after the others: kill-timing tests whose bounds assume an otherwise idle machine.
 alone="$build/tests/test_atomic_save"
-# The slow ones first, by CPU cost (issue 24's budgets, session 4's numbers: test_import and
+# The slow ones first, by wall time (valgrind runs on one core) (issue 24's budgets, session 4's numbers: test_import and
 # test_env_tool.sh are cheap now); then the rest in name order; the browser test last: it mostly waits
 # on the browser, and the native tests' wall time is the one that counts.
-slow="tests/test_viewer.sh tests/test_valgrind.sh $build/tests/test_mobile $build/tests/test_truth
+slow="tests/test_valgrind.sh tests/test_viewer.sh $build/tests/test_mobile $build/tests/test_truth
       $build/tests/test_edges $build/tests/test_render $build/tests/test_fine_makeup $build/tests/test_paint_render
       $build/tests/test_lighting tests/test_robustness.sh $build/tests/test_incremental $build/tests/test_shadow"
 last="tests/test_web.sh"
