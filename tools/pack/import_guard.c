@@ -172,7 +172,7 @@ static int cmp_edge(const void *a, const void *b)
 static rs_result graph_check(graph *g, const char *name, const char *what, rs_error *err)
 {
     if (!g->count) return RS_OK;
-    qsort(g->edges, g->edge_count, sizeof *g->edges, cmp_edge);
+    if (g->edge_count) qsort(g->edges, g->edge_count, sizeof *g->edges, cmp_edge);  // no edges: edges may be NULL
     uint32_t *first = calloc((size_t)g->count + 1, sizeof *first);
     uint8_t *state = calloc(g->count, 1);  // 0 new, 1 on the path, 2 done
     uint32_t *depth = calloc(g->count, sizeof *depth);
