@@ -43,6 +43,22 @@ static void depth_compare(GLenum target)
     glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
 }
 
+// A depth-only framebuffer (bound, its depth attached): no colour buffers; checked, unbound; on failure
+// the framebuffer and texture are deleted.
+static rs_result finish_depth_fbo(GLuint *fbo, GLuint *tex, const char *what, rs_error *err)
+{
+    GLenum none = GL_NONE;
+    glDrawBuffers(1, &none);
+    glReadBuffer(GL_NONE);
+    rs_result res = rs_render_fbo_check(what, err);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (res != RS_OK) {
+        glDeleteFramebuffers(1, fbo);
+        glDeleteTextures(1, tex);
+    }
+    return res;
+}
+
 static rs_result ensure_map(rs_renderer *r, rs_shadow_map *m, int want, rs_error *err)
 {
     if (m->tex) return RS_OK;
@@ -52,16 +68,10 @@ static rs_result ensure_map(rs_renderer *r, rs_shadow_map *m, int want, rs_error
     glGenFramebuffers(1, &m->fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, m->tex, 0);
-    GLenum none = GL_NONE;
-    glDrawBuffers(1, &none);
-    glReadBuffer(GL_NONE);
     char what[64];
     snprintf(what, sizeof what, "shadow map (DEPTH_COMPONENT32F %dx%d)", size, size);
-    rs_result res = rs_render_fbo_check(what, err);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    rs_result res = finish_depth_fbo(&m->fbo, &m->tex, what, err);
     if (res != RS_OK) {
-        glDeleteFramebuffers(1, &m->fbo);
-        glDeleteTextures(1, &m->tex);
         memset(m, 0, sizeof *m);
         return res;
     }
@@ -83,16 +93,10 @@ static rs_result ensure_lamp_maps(rs_renderer *r, rs_error *err)
     glGenFramebuffers(1, &l->fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, l->fbo);
     glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, l->tex, 0, 0);
-    GLenum none = GL_NONE;
-    glDrawBuffers(1, &none);
-    glReadBuffer(GL_NONE);
     char what[80];
     snprintf(what, sizeof what, "lamp shadow maps (DEPTH_COMPONENT32F %dx%dx%d)", size, size, RS_ENV_LAMPS);
-    rs_result res = rs_render_fbo_check(what, err);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    rs_result res = finish_depth_fbo(&l->fbo, &l->tex, what, err);
     if (res != RS_OK) {
-        glDeleteFramebuffers(1, &l->fbo);
-        glDeleteTextures(1, &l->tex);
         memset(l, 0, sizeof *l);
         return res;
     }
