@@ -104,19 +104,21 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     float d2 = min(sigma * sqrt(max(across * across - s * s, 0.0)), 0.6);
     float g1 = d1 * d1 / (2.0 * sigma * sigma), g2 = d2 * d2 / (2.0 * sigma * sigma * max(across * across, 1e-4));
     float lod = rs_env_lod(s * m);
-    vec2 o1 = vec2(tan(d1), tan(2.0 * d1)), o2 = vec2(tan(d2), tan(2.0 * d2));
     float fc = max(rs_ksk_lobe(N, R, V, m, f0), 1e-20);
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
+    // Offsets and weights from the loop counters alone: a small local array indexed by them cost the H100
+    // an eighth of the environment's time (it went to local memory).
     for (int i = -2; i <= 2; i++) {
-        float a = i == 0 ? 0.0 : sign(float(i)) * o1[abs(i) - 1];
+        float a = tan(float(i) * d1);
         for (int j = -2; j <= 2; j++) {
-            float b = j == 0 ? 0.0 : sign(float(j)) * o2[abs(j) - 1];
+            float b = tan(float(j) * d2);
             vec3 l = normalize(R + t1 * a + t2 * b);
             float f = rs_ksk_lobe(N, l, V, m, f0);
             if (f <= 0.0) continue;
             // Binomial weights times the real lobe over the Gaussian the grid stands for.
-            float bi = i == 0 ? 6.0 : abs(i) == 1 ? 4.0 : 1.0, bj = j == 0 ? 6.0 : abs(j) == 1 ? 4.0 : 1.0;
+            float bi = 6.0 - 2.25 * float(i * i) + 0.25 * float(i * i * i * i);  // 1 4 6 4 1
+            float bj = 6.0 - 2.25 * float(j * j) + 0.25 * float(j * j * j * j);
             float w = bi * bj * (f / fc) * exp(float(i * i) * g1 + float(j * j) * g2);
             sum += rs_env_radiance(l, lod) * w;
             wsum += w;

@@ -702,6 +702,45 @@ static void paint_row(bench *b, rs_gl_context *gl, const char *cosmetic, float s
     rs_render_destroy(r);
 }
 
+// Where the environment's cost goes: the same two renderers with each stage glFinish-timed (slower overall, so
+// a row of its own), the median per stage under the environment minus under the lamp.
+static void env_stage_row(bench *b, rs_gl_context *gl)
+{
+    const char *what = "environment cost per stage, mobile 512x512";
+    rs_renderer *r[2] = {NULL, NULL};
+    rs_env *env = NULL;
+    rs_error err = {0};
+    bool ok = rs_env_open(RS_ENV_DEFAULT, NULL, &env, &err) == RS_OK;
+    for (int k = 0; ok && k < 2; k++)
+        ok = rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl), .time_stages = true},
+                              &r[k], &err) == RS_OK;
+    ok = ok && rs_render_set_env(r[0], env, &err) == RS_OK;
+    rs_env_destroy(env);
+    static double st[2][RS_STAGE_COUNT][64];
+    int frames = RS_MIN(b->frames, 64);
+    for (int i = -1; ok && i < frames; i++)
+        for (int k = 0; ok && k < 2; k++) {
+            rs_view v = rs_view_defaults();
+            v.width = v.height = 512;
+            v.pipeline = RS_PIPELINE_MOBILE;
+            v.lighting = k == 0 ? RS_LIGHTING_ENV : RS_LIGHTING_LIGHTS;
+            rs_render_invalidate(r[k]);
+            ok = rs_render_frame(r[k], &v, &err) == RS_OK;
+            rs_render_stats s = rs_render_get_stats(r[k]);
+            for (int j = 0; ok && i >= 0 && j < RS_STAGE_COUNT; j++) st[k][j][i] = s.stage_ms[j];
+        }
+    if (ok) {
+        double d[RS_STAGE_COUNT];
+        for (int j = 0; j < RS_STAGE_COUNT; j++) d[j] = bench_median(st[0][j], frames) - bench_median(st[1][j], frames);
+        add_row(b, what, "environment minus lamp, median ms per stage, glFinish after each; the shadow maps are cached",
+                "shadow %+.2f, visibility %+.2f, attribute %+.2f, diffusion %+.2f, composite %+.2f ms", d[0], d[1], d[2],
+                d[3], d[4]);
+    } else {
+        add_row(b, what, NULL, "n/a (%s)", err.msg);
+    }
+    for (int k = 0; k < 2; k++) rs_render_destroy(r[k]);
+}
+
 // What lighting by an environment costs the mobile frame (issue 12: at most ~15%): the default
 // environment against the paper's lamp, same view, two renderers timed frame by frame in turn.
 static void env_row(bench *b, rs_gl_context *gl)
@@ -739,6 +778,7 @@ static void env_row(bench *b, rs_gl_context *gl)
         add_row(b, what, NULL, "n/a (%s)", err.msg);
     }
     for (int k = 0; k < 2; k++) rs_render_destroy(r[k]);
+    if (ok) env_stage_row(b, gl);
 }
 
 // Where a frame's time goes, per stage (glFinish after each stage: slower overall, so separate rows).
