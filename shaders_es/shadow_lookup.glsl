@@ -92,8 +92,10 @@ float rs_lamp_shadow(int k, vec3 p, vec3 n)
         // edge along either axis.
         vec2 g = vec2(i & 1, i >> 1) - 0.5;
         vec2 o = vec2(0.8944 * g.x - 0.4472 * g.y, 0.4472 * g.x + 0.8944 * g.y) * 1.5 * u_lamp_shadow_texel;
-        sum += textureGrad(u_lamp_shadow_map, vec4(s.xy + o, float(k), s.z + dot(grad, o) - bias), vec2(0.0),
-                           vec2(0.0));
+        // texture(), not textureGrad() (ES 3.0 has no textureLod for array shadows): the array has one level
+        // and equal min/mag filters, so the implicit level cannot matter, and explicit gradients made the
+        // H100 take a path that cost as much as the rest of the lamps' lookups.
+        sum += texture(u_lamp_shadow_map, vec4(s.xy + o, float(k), s.z + dot(grad, o) - bias));
     }
     return sum / 4.0 * attached;
 }
