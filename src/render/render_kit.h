@@ -140,6 +140,7 @@ typedef struct rs_diffusion_level {
 // reference's rule) blurs the decimated image and grows its silhouette: 34.7 instead of 41.8 dB
 // against the reference at 512x512 with the 145k prefix.
 #define RS_MOBILE_COVER 0.55f
+// The key's map: at most this size, and no larger than the output needs (render_shadow.c map_size).
 #define RS_SHADOW_SIZE_REFERENCE 4096
 #define RS_SHADOW_SIZE_MOBILE 2048
 // The PCF filter's grid step is 1.5 texels of a map this size whatever the map's own size, so that
@@ -156,13 +157,13 @@ typedef struct rs_shadow_map {
     float radius;            // typical splat radius in the map, model units
 } rs_shadow_map;
 
-// The environment's other lamps' shadow maps (render_shadow.c): one depth atlas of 2 x 2 tiles, one per
-// lamp, shared by both pipelines (drawn from one LOD prefix whatever the pipeline), cached per lamp.
-#define RS_LAMP_SHADOW_SIZE 1024       // a tile
+// The environment's other lamps' shadow maps (render_shadow.c): one depth array, a layer per lamp,
+// shared by both pipelines (drawn from one LOD prefix whatever the pipeline), cached per lamp.
+#define RS_LAMP_SHADOW_SIZE 1024       // a layer's side, at most
 #define RS_LAMP_SHADOW_SPLATS 160000   // the LOD prefix drawn (at most)
 typedef struct rs_lamp_shadows {
     GLuint tex, fbo;
-    int size;                          // a tile's side
+    int size;                          // a layer's side
     mat4 vp[RS_ENV_LAMPS];             // model -> the tile's light clip
     float key[RS_ENV_LAMPS][6];        // as rs_shadow_map.key
     float radius;                      // typical splat radius in the maps, model units

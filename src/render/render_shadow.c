@@ -12,11 +12,25 @@
 #include <math.h>
 #include <string.h>
 
-// Reference: 4096^2, texels of 0.14 mm on the bundled bust (bounding sphere 6.2 units, 47 mm/unit). An
-// occluder's edge in the map is quantised to texels, which moves its shadow's edge by up to half a texel
-// / cos(theta) on the receiver: 0.29 mm at 60 degrees with 2048^2 (over the 0.3 mm the edge may be off),
-// 0.14 mm with 4096^2 (tests/test_shadow.c). Mobile: 1024^2 (RS_SHADOW_SIZE_MOBILE), texels of 0.57 mm,
-// still below the PCF penumbra (~2 mm); its edges are within 0.6 mm.
+// Reference: up to 4096^2, texels of 0.14 mm on the bundled bust (bounding sphere 6.2 units, 47 mm/unit).
+// An occluder's edge in the map is quantised to texels, which moves its shadow's edge by up to half a
+// texel / cos(theta) on the receiver: 0.29 mm at 60 degrees with 2048^2 (over the 0.3 mm the edge may be
+// off), 0.14 mm with 4096^2 (tests/test_shadow.c). Mobile: up to 2048^2 (RS_SHADOW_SIZE_MOBILE), texels
+// of 0.28 mm, below the PCF penumbra (~2 mm). A smaller picture needs fewer: a map texel no larger than a
+// pixel at the nearest point of the bounding sphere (which the map spans) keeps its quantisation within
+// a pixel wherever the face is. At the default 512^2 view that asks for 2400 texels, so both pipelines
+// keep their caps from there up (the viewer, the figures, every close-up); a 256^2 picture draws a
+// quarter of the reference's texels (the map pass's cost is its texels), a 48^2 one a sixteenth of the
+// mobile's, and both pipelines get the same map where both caps allow (a 256^2 comparison of the two
+// measures their diffusion, not their maps: test_mobile's K = 3 edge test). The lamps' layers, soft
+// sources: half that, up to 1024^2.
+static int map_size(const rs_renderer *r, const rs_frame *f, float texels_per_px, int lo, int hi)
+{
+    float need = 2.02f * r->bound_radius * f->cam.ppu_max * texels_per_px;  // the ortho range is 2.02 R
+    int size = lo;
+    while ((float)size < need && size < hi) size *= 2;
+    return RS_MIN(size, r->caps.max_texture_size);
+}
 
 void rs_render_shadow_release(rs_renderer *r)
 {
@@ -59,10 +73,13 @@ static rs_result finish_depth_fbo(GLuint *fbo, GLuint *tex, const char *what, rs
     return res;
 }
 
-static rs_result ensure_map(rs_renderer *r, rs_shadow_map *m, int want, rs_error *err)
+// The key's map of side `size` (a new one when the size changes: the old drawing is dropped with it).
+static rs_result ensure_map(rs_shadow_map *m, int size, rs_error *err)
 {
-    if (m->tex) return RS_OK;
-    int size = RS_MIN(want, r->caps.max_texture_size);
+    if (m->tex && m->size == size) return RS_OK;
+    glDeleteFramebuffers(1, &m->fbo);
+    glDeleteTextures(1, &m->tex);
+    memset(m, 0, sizeof *m);
     m->tex = rs_render_texture(GL_DEPTH_COMPONENT32F, size, size);
     depth_compare(GL_TEXTURE_2D);
     glGenFramebuffers(1, &m->fbo);
@@ -80,11 +97,13 @@ static rs_result ensure_map(rs_renderer *r, rs_shadow_map *m, int want, rs_error
 }
 
 // The lamps' depth array (a layer each) and the framebuffer their layers are attached to in turn.
-static rs_result ensure_lamp_maps(rs_renderer *r, rs_error *err)
+static rs_result ensure_lamp_maps(rs_renderer *r, int size, rs_error *err)
 {
     rs_lamp_shadows *l = &r->lamp_shadow;
-    if (l->tex) return RS_OK;
-    int size = RS_MIN(RS_LAMP_SHADOW_SIZE, r->caps.max_texture_size);
+    if (l->tex && l->size == size) return RS_OK;
+    glDeleteFramebuffers(1, &l->fbo);
+    glDeleteTextures(1, &l->tex);
+    memset(l, 0, sizeof *l);
     glGenTextures(1, &l->tex);
     glBindTexture(GL_TEXTURE_2D_ARRAY, l->tex);
     glTexStorage3D(GL_TEXTURE_2D_ARRAY, 1, GL_DEPTH_COMPONENT32F, size, size, RS_ENV_LAMPS);
@@ -171,7 +190,7 @@ static void lookup_matrices(const rs_frame *f, const mat4 vp, mat4 out, mat3 nor
 // RS_LAMP_SHADOW_SPLATS, within the view's cap), so the pipelines share the maps and agree on them.
 static rs_result lamp_shadows(rs_renderer *r, rs_frame *f, rs_error *err)
 {
-    rs_result res = ensure_lamp_maps(r, err);
+    rs_result res = ensure_lamp_maps(r, map_size(r, f, 0.5f, 256, RS_LAMP_SHADOW_SIZE), err);
     if (res != RS_OK) return res;
     rs_lamp_shadows *l = &r->lamp_shadow;
     const rs_splat_cloud *c = r->cloud;
@@ -218,7 +237,8 @@ static rs_result lamp_shadows(rs_renderer *r, rs_frame *f, rs_error *err)
 rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
 {
     rs_shadow_map *m = &r->shadow[f->shadow_slot];
-    rs_result res = ensure_map(r, m, f->mobile ? RS_SHADOW_SIZE_MOBILE : RS_SHADOW_SIZE_REFERENCE, err);
+    int cap = f->mobile ? RS_SHADOW_SIZE_MOBILE : RS_SHADOW_SIZE_REFERENCE;
+    rs_result res = ensure_map(m, map_size(r, f, 1.0f, 512, cap), err);
     if (res != RS_OK) return res;
     // The key light direction back in model space.
     vec3 L;
