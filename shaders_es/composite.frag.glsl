@@ -132,6 +132,34 @@ vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, float amo
     return s3 * (tint * (FLAKE_REFLECTANCE * cover));
 }
 
+// Burley's diffuse retro-reflection (Burley 2012, sec. 5.3; as a separate surface lobe beside the
+// subsurface, Burley 2015 sec. 2.3): a rough dielectric throws light back towards where it came from, the
+// more the more grazing the view or the light, RR (F_L + F_V + F_L F_V (RR - 1)) N.L / pi with
+// F = (1 - cos)^5 and RR = r (1 + L.V), r the roughness (sqrt of the lobe's m, as tools/truth/ maps it).
+// Lambert has no such term, and that was the contour band's darkness (issue 22): the path tracer's skin
+// (Cycles 3.4's Principled BSDF, random-walk subsurface plus this lobe, no entry Fresnel) brightened by
+// 1.23x over the same scene with Lambert's exit at N.V 0.2, 1.10x at 0.4, <= 2 % beyond 0.6, on both the
+// lit and unlit sides, so rouge's whole silhouette ring (skull, jaw, the nose's sides) drew 10-25 % darker.
+// It is a surface term: per pixel, times the albedo, not scattered under the skin. A light of colour e
+// (its irradiance at normal incidence) from view-space direction l:
+vec3 burley_retro_light(vec3 e, vec3 N, vec3 l, vec3 V, float r, float fv)
+{
+    float nl = dot(N, l);
+    if (nl <= 0.0) return vec3(0.0);
+    float fl = pow(1.0 - nl, 5.0), rr = r * (1.0 + dot(l, V));
+    return e * (nl * rr * (fl + fv + fl * fv * (rr - 1.0)));
+}
+
+// The retro-reflection of the environment's SH light (smooth): its F_V term, which carries the grazing
+// view's brightening (the F_L terms, ~5 % of the SH light at any view, are left out). Its integral of
+// L (N.l) (1 + l.V) is taken as the SH irradiance at the normal bent halfway to the eye (the (1 + l.V)
+// weight leans the cosine lobe towards V) times 1 + 2/3 N.V (exact under uniform light); with the ambient
+// occlusion as the SH irradiance has it.
+vec3 burley_retro_env(vec3 N, vec3 V, float r, float fv, float ao)
+{
+    return rs_env_irradiance(normalize(N + V)) * (ao * r * fv * (1.0 + 0.6667 * max(dot(N, V), 0.0)));
+}
+
 vec3 linear_to_srgb(vec3 c)
 {
     c = clamp(c, 0.0, 1.0);
@@ -309,7 +337,7 @@ void main()
                + u_ambient;
         // The makeup's clear coat: the same lobe family, smooth (m 0.1), F0 0.04, untinted, on top.
         const float mc = 0.1;
-        vec3 C = vec3(0.0), Eb = vec3(0.0);
+        vec3 C = vec3(0.0), Eb = vec3(0.0), vis = vec3(1.0);
         if (coat > 0.0)
             C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
                                * shadow);
@@ -319,7 +347,7 @@ void main()
             float ndotv = dot(N, V);
             float so = ao * contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv))
                      * reflection_open(p, reflect(-V, N));
-            vec3 vis = rs_env_lamp_visibility(p, N);
+            vis = rs_env_lamp_visibility(p, N);
             E += rs_env_irradiance(N) * ao + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
@@ -360,6 +388,18 @@ void main()
         if (edge_on > 0.0) {
             float k = 1.25 * (El.r + 1e-4) / (El.g + 1e-4);
             Dd.r = mix(Dd.r, min(Dd.r, k * Dd.g), edge_on);
+        }
+        // Under an environment (rouge's realistic lighting; the paper's lights keep the paper's Lambert
+        // diffuse and its figures), the diffuse is Burley's: the retro-reflection of the key light, the
+        // environment's lamps and its SH light, per pixel on top of the subsurface D.
+        if (u_env_on > 0.5) {
+            float fv = pow(1.0 - clamp(dot(N, V), 0.0, 1.0), 5.0), r = sqrt(max(m, 0.0));
+            vec3 Er = burley_retro_light(u_key_color * shadow, N, u_key_dir, V, r, fv)
+                    + burley_retro_env(N, V, r, fv, ao);
+            for (int i = 0; i < 3; i++)
+                Er += burley_retro_light(u_env_lamp_color[i] * vis[i], N, transpose(u_env_from_view) * u_env_lamp_dir[i],
+                                         V, r, fv);
+            Dd += Er;
         }
         if (u_mode == MODE_DIFFUSE) c = A * Dd;
         else if (u_mode == MODE_SPECULAR) c = S + C;
