@@ -218,9 +218,9 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
 // a bright 1-px outline along such contours. The surface behind is looked for across the contour, a few
 // pixels along the screen projection of the normal: one that lies behind this point and faces the eye
 // (the same surface curving away stays edge-on there: a cheek's grazing sheen is kept), within
-// u_contour_reach, occludes the rim (fully up to half the reach); background or a far surface leaves it
-// open (a real rim light).
-float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
+// u_contour_reach, occludes the rim (fully up to half the reach; hit: its pixel, whose skin the rim
+// reflects instead, skin_at); background or a far surface leaves it open (a real rim light).
+float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
 {
     if (edge_on <= 0.0 || dot(N.xy, N.xy) < 1e-6) return 1.0;
     vec2 d = normalize(N.xy);
@@ -234,7 +234,8 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
         if (a.a <= u_min_weight) continue;
         vec3 nq = normalize(texelFetch(u_attr1, clamp(ivec2(f), ivec2(0), hi), 0).xyz / a.a * 2.0 - 1.0);
         float behind = p.z - q.z;
-        if (behind > 0.05 * u_contour_reach && dot(nq, normalize(-q)) > ndotv + 0.25) gap = min(gap, behind);
+        if (behind > 0.05 * u_contour_reach && dot(nq, normalize(-q)) > ndotv + 0.25 && behind < gap)
+            gap = behind, hit = clamp(ivec2(f), ivec2(0), hi);
     }
     return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
 }
@@ -248,8 +249,8 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
 // R is marched 2.5 to 80 mm (steps doubling: an ear's folds are a few mm deep) through the depth buffer: a point that lies behind the visible
 // surface at its pixel by more than 1-3 mm (and less than a head's depth: beyond that the ray passes
 // behind the head) is inside the head and blocks the reflection. Background and the frame's edge leave it
-// open.
-float reflection_open(vec3 p, vec3 R)
+// open. hit: the pixel of the surface that blocks it most.
+float reflection_open(vec3 p, vec3 R, inout ivec2 hit)
 {
     float open = 1.0;
     float d = 0.125 * u_contour_reach;
@@ -262,10 +263,24 @@ float reflection_open(vec3 p, vec3 R)
         vec3 s;
         if (!rs_visible_point_at(rs_depth_pixel(f), s)) continue;
         float behind = s.z - q.z;
-        open = min(open, 1.0 - smoothstep(0.05 * u_contour_reach, 0.15 * u_contour_reach, behind)
-                              * (1.0 - smoothstep(8.0 * u_contour_reach, 10.0 * u_contour_reach, behind)));
+        float o = 1.0 - smoothstep(0.05 * u_contour_reach, 0.15 * u_contour_reach, behind)
+                        * (1.0 - smoothstep(8.0 * u_contour_reach, 10.0 * u_contour_reach, behind));
+        if (o < open) open = o, hit = rs_depth_pixel(f);
     }
     return open;
+}
+
+// What a reflection that the face itself blocks sees instead of the sky: the skin it runs into, at the
+// pixel hit (the nearest surface behind a contour, the one a marched reflection passes behind), as the
+// camera sees it diffusely there, A D (the narrowest levels' share taken at their luminance). Black
+// before: at the chin's edge over the neck that drew a dark line where the path tracer shows the neck's
+// reflection, reddish at grazing Fresnel (issue 22).
+vec3 skin_at(ivec2 q)
+{
+    vec4 a = texelFetch(u_attr0, q, 0);
+    if (a.a <= u_min_weight) return vec3(0.0);
+    vec4 d = texelFetch(u_diffuse, q, 0) * u_diffuse_scale;
+    return a.rgb / a.a * (d.rgb + u_delta_weight * d.a);
 }
 
 bool uncovered(ivec2 q)
@@ -345,8 +360,10 @@ void main()
             // Sky occlusion stands in for the specular's visibility too (eye sockets, nostrils), and at
             // contours the surface just behind them.
             float ndotv = dot(N, V);
-            float so = ao * contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv))
-                     * reflection_open(p, reflect(-V, N));
+            ivec2 hit_c = ivec2(-1), hit_r = ivec2(-1);
+            float open_c = contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv), hit_c);
+            float open_r = reflection_open(p, reflect(-V, N), hit_r);
+            float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
             E += rs_env_irradiance(N) * ao + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
@@ -355,6 +372,11 @@ void main()
             // The map's reflection less the lamps that this point's shadow maps hide.
             S += max(rs_env_specular(N, V, m, RS_F0_SKIN) - rs_env_lamp_specular_hidden(N, V, m, RS_F0_SKIN, vis),
                      vec3(0.0)) * (rho_s * so);
+            // Where the face blocks it, the reflection shows the skin it runs into.
+            vec3 blocked = vec3(0.0);
+            if (open_c < 1.0 && hit_c.x >= 0) blocked += (1.0 - open_c) * skin_at(hit_c);
+            if (open_r < 1.0 && hit_r.x >= 0) blocked += open_c * (1.0 - open_r) * skin_at(hit_r);
+            S += blocked * (ao * rho_s * rs_env_lobe_albedo(max(ndotv, 1e-4), m, RS_F0_SKIN));
             if (coat > 0.0)
                 C += max(rs_env_specular(N, V, mc, RS_F0_COAT) - rs_env_lamp_specular_hidden(N, V, mc, RS_F0_COAT, vis),
                          vec3(0.0)) * so;
