@@ -132,6 +132,34 @@ vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, float amo
     return s3 * (tint * (FLAKE_REFLECTANCE * cover));
 }
 
+// Burley's diffuse retro-reflection (Burley 2012, sec. 5.3; as a separate surface lobe beside the
+// subsurface, Burley 2015 sec. 2.3): a rough dielectric throws light back towards where it came from, the
+// more the more grazing the view or the light, RR (F_L + F_V + F_L F_V (RR - 1)) N.L / pi with
+// F = (1 - cos)^5 and RR = r (1 + L.V), r the roughness (sqrt of the lobe's m, as tools/truth/ maps it).
+// Lambert has no such term, and that was the contour band's darkness (issue 22): the path tracer's skin
+// (Cycles 3.4's Principled BSDF, random-walk subsurface plus this lobe, no entry Fresnel) brightened by
+// 1.23x over the same scene with Lambert's exit at N.V 0.2, 1.10x at 0.4, <= 2 % beyond 0.6, on both the
+// lit and unlit sides, so rouge's whole silhouette ring (skull, jaw, the nose's sides) drew 10-25 % darker.
+// It is a surface term: per pixel, times the albedo, not scattered under the skin. A light of colour e
+// (its irradiance at normal incidence) from view-space direction l:
+vec3 burley_retro_light(vec3 e, vec3 N, vec3 l, vec3 V, float r, float fv)
+{
+    float nl = dot(N, l);
+    if (nl <= 0.0) return vec3(0.0);
+    float fl = pow(1.0 - nl, 5.0), rr = r * (1.0 + dot(l, V));
+    return e * (nl * rr * (fl + fv + fl * fv * (rr - 1.0)));
+}
+
+// The retro-reflection of the environment's SH light (smooth): its F_V term, which carries the grazing
+// view's brightening (the F_L terms, ~5 % of the SH light at any view, are left out). Its integral of
+// L (N.l) (1 + l.V) is taken as the SH irradiance at the normal bent halfway to the eye (the (1 + l.V)
+// weight leans the cosine lobe towards V) times 1 + 2/3 N.V (exact under uniform light); with the ambient
+// occlusion as the SH irradiance has it.
+vec3 burley_retro_env(vec3 N, vec3 V, float r, float fv, float ao)
+{
+    return rs_env_irradiance(normalize(N + V)) * (ao * r * fv * (1.0 + 0.6667 * max(dot(N, V), 0.0)));
+}
+
 vec3 linear_to_srgb(vec3 c)
 {
     c = clamp(c, 0.0, 1.0);
@@ -190,9 +218,9 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
 // a bright 1-px outline along such contours. The surface behind is looked for across the contour, a few
 // pixels along the screen projection of the normal: one that lies behind this point and faces the eye
 // (the same surface curving away stays edge-on there: a cheek's grazing sheen is kept), within
-// u_contour_reach, occludes the rim (fully up to half the reach); background or a far surface leaves it
-// open (a real rim light).
-float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
+// u_contour_reach, occludes the rim (fully up to half the reach; hit: its pixel, whose skin the rim
+// reflects instead, skin_at); background or a far surface leaves it open (a real rim light).
+float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
 {
     if (edge_on <= 0.0 || dot(N.xy, N.xy) < 1e-6) return 1.0;
     vec2 d = normalize(N.xy);
@@ -206,7 +234,8 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
         if (a.a <= u_min_weight) continue;
         vec3 nq = normalize(texelFetch(u_attr1, clamp(ivec2(f), ivec2(0), hi), 0).xyz / a.a * 2.0 - 1.0);
         float behind = p.z - q.z;
-        if (behind > 0.05 * u_contour_reach && dot(nq, normalize(-q)) > ndotv + 0.25) gap = min(gap, behind);
+        if (behind > 0.05 * u_contour_reach && dot(nq, normalize(-q)) > ndotv + 0.25 && behind < gap)
+            gap = behind, hit = clamp(ivec2(f), ivec2(0), hi);
     }
     return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
 }
@@ -220,8 +249,8 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on)
 // R is marched 2.5 to 80 mm (steps doubling: an ear's folds are a few mm deep) through the depth buffer: a point that lies behind the visible
 // surface at its pixel by more than 1-3 mm (and less than a head's depth: beyond that the ray passes
 // behind the head) is inside the head and blocks the reflection. Background and the frame's edge leave it
-// open.
-float reflection_open(vec3 p, vec3 R)
+// open. hit: the pixel of the surface that blocks it most.
+float reflection_open(vec3 p, vec3 R, inout ivec2 hit)
 {
     float open = 1.0;
     float d = 0.125 * u_contour_reach;
@@ -234,10 +263,24 @@ float reflection_open(vec3 p, vec3 R)
         vec3 s;
         if (!rs_visible_point_at(rs_depth_pixel(f), s)) continue;
         float behind = s.z - q.z;
-        open = min(open, 1.0 - smoothstep(0.05 * u_contour_reach, 0.15 * u_contour_reach, behind)
-                              * (1.0 - smoothstep(8.0 * u_contour_reach, 10.0 * u_contour_reach, behind)));
+        float o = 1.0 - smoothstep(0.05 * u_contour_reach, 0.15 * u_contour_reach, behind)
+                        * (1.0 - smoothstep(8.0 * u_contour_reach, 10.0 * u_contour_reach, behind));
+        if (o < open) open = o, hit = rs_depth_pixel(f);
     }
     return open;
+}
+
+// What a reflection that the face itself blocks sees instead of the sky: the skin it runs into, at the
+// pixel hit (the nearest surface behind a contour, the one a marched reflection passes behind), as the
+// camera sees it diffusely there, A D (the narrowest levels' share taken at their luminance). Black
+// before: at the chin's edge over the neck that drew a dark line where the path tracer shows the neck's
+// reflection, reddish at grazing Fresnel (issue 22).
+vec3 skin_at(ivec2 q)
+{
+    vec4 a = texelFetch(u_attr0, q, 0);
+    if (a.a <= u_min_weight) return vec3(0.0);
+    vec4 d = texelFetch(u_diffuse, q, 0) * u_diffuse_scale;
+    return a.rgb / a.a * (d.rgb + u_delta_weight * d.a);
 }
 
 bool uncovered(ivec2 q)
@@ -309,7 +352,7 @@ void main()
                + u_ambient;
         // The makeup's clear coat: the same lobe family, smooth (m 0.1), F0 0.04, untinted, on top.
         const float mc = 0.1;
-        vec3 C = vec3(0.0), Eb = vec3(0.0);
+        vec3 C = vec3(0.0), Eb = vec3(0.0), vis = vec3(1.0);
         if (coat > 0.0)
             C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
                                * shadow);
@@ -317,9 +360,11 @@ void main()
             // Sky occlusion stands in for the specular's visibility too (eye sockets, nostrils), and at
             // contours the surface just behind them.
             float ndotv = dot(N, V);
-            float so = ao * contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv))
-                     * reflection_open(p, reflect(-V, N));
-            vec3 vis = rs_env_lamp_visibility(p, N);
+            ivec2 hit_c = ivec2(-1), hit_r = ivec2(-1);
+            float open_c = contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv), hit_c);
+            float open_r = reflection_open(p, reflect(-V, N), hit_r);
+            float so = ao * open_c * open_r;
+            vis = rs_env_lamp_visibility(p, N);
             E += rs_env_irradiance(N) * ao + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
@@ -327,6 +372,11 @@ void main()
             // The map's reflection less the lamps that this point's shadow maps hide.
             S += max(rs_env_specular(N, V, m, RS_F0_SKIN) - rs_env_lamp_specular_hidden(N, V, m, RS_F0_SKIN, vis),
                      vec3(0.0)) * (rho_s * so);
+            // Where the face blocks it, the reflection shows the skin it runs into.
+            vec3 blocked = vec3(0.0);
+            if (open_c < 1.0 && hit_c.x >= 0) blocked += (1.0 - open_c) * skin_at(hit_c);
+            if (open_r < 1.0 && hit_r.x >= 0) blocked += open_c * (1.0 - open_r) * skin_at(hit_r);
+            S += blocked * (ao * rho_s * rs_env_lobe_albedo(max(ndotv, 1e-4), m, RS_F0_SKIN));
             if (coat > 0.0)
                 C += max(rs_env_specular(N, V, mc, RS_F0_COAT) - rs_env_lamp_specular_hidden(N, V, mc, RS_F0_COAT, vis),
                          vec3(0.0)) * so;
@@ -360,6 +410,18 @@ void main()
         if (edge_on > 0.0) {
             float k = 1.25 * (El.r + 1e-4) / (El.g + 1e-4);
             Dd.r = mix(Dd.r, min(Dd.r, k * Dd.g), edge_on);
+        }
+        // Under an environment (rouge's realistic lighting; the paper's lights keep the paper's Lambert
+        // diffuse and its figures), the diffuse is Burley's: the retro-reflection of the key light, the
+        // environment's lamps and its SH light, per pixel on top of the subsurface D.
+        if (u_env_on > 0.5) {
+            float fv = pow(1.0 - clamp(dot(N, V), 0.0, 1.0), 5.0), r = sqrt(max(m, 0.0));
+            vec3 Er = burley_retro_light(u_key_color * shadow, N, u_key_dir, V, r, fv)
+                    + burley_retro_env(N, V, r, fv, ao);
+            for (int i = 0; i < 3; i++)
+                Er += burley_retro_light(u_env_lamp_color[i] * vis[i], N, transpose(u_env_from_view) * u_env_lamp_dir[i],
+                                         V, r, fv);
+            Dd += Er;
         }
         if (u_mode == MODE_DIFFUSE) c = A * Dd;
         else if (u_mode == MODE_SPECULAR) c = S + C;

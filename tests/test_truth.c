@@ -9,7 +9,7 @@
 //   - path tracer / rouge mean scene-linear luminance under the chin, on the lips, ears, nose, eye sockets
 //     (the fixture's label plane: .rsf regions of the nearest splat, ears and under-chin by geometry);
 //   - rouge / path tracer mean luminance of the contour band (3 px inside the silhouette and on the near side
-//     of depth steps over 10 mm: where rouge drew dark outlines).
+//     of depth steps over 10 mm: where rouge drew dark outlines), over pixels both cover fully.
 // Issue 22's goals: mean dE <= 2.0, every ratio within [0.87, 1.15], the band no darker (>= 1). Where a goal
 // is not met the test guards the number measured when the fixtures were made (the `was` table) against
 // regressions and reports the goal as a skip. Also checked: the silhouettes agree (IoU) and rouge's albedo
@@ -47,18 +47,20 @@ typedef struct measured {
     double delta_e, ratio[R_COUNT], band;
 } measured;
 static const measured was[] = {
-    // Measured with the environment's other lamps shadow-mapped (render_shadow.c; before: studio 2.07 / 2.53,
-    // daylight 1.81 / 1.58, office 2.10 / 1.71, sunset 1.97 / 1.70; studio 3/4's ears 0.825). Every view now
-    // meets the dE goal and is held to it. Studio front's band (1.023) is still lifted by the temple's
-    // sheen (the map's reflection of the side lamp), not a goal met: its guard keeps the value from before.
-    {"studio", "front", 1.91, {1.070, 1.020, 1.014, 1.039, 0.998}, 0.876},
-    {"studio", "threequarter", 1.86, {1.068, 1.065, 0.931, 1.026, 1.006}, 0.908},
-    {"daylight", "front", 1.67, {1.012, 0.990, 1.002, 1.019, 1.014}, 0.885},
-    {"daylight", "threequarter", 1.46, {0.987, 1.015, 0.932, 0.991, 1.010}, 0.919},
-    {"office", "front", 1.85, {1.043, 1.018, 1.022, 1.014, 1.026}, 0.974},
-    {"office", "threequarter", 1.59, {1.033, 1.062, 0.991, 0.998, 1.032}, 0.978},
-    {"sunset", "front", 1.78, {1.100, 1.056, 1.041, 1.059, 1.078}, 0.886},
-    {"sunset", "threequarter", 1.59, {1.091, 1.080, 0.967, 1.025, 1.073}, 0.914},
+    // Measured with Burley's diffuse retro-reflection under environments and blocked reflections showing
+    // the skin they run into (composite.frag.glsl; before: band 0.876-0.978 in 7 of 8 views, dE studio
+    // 1.91 / 1.86, daylight 1.67 / 1.46, office 1.85 / 1.59, sunset 1.78 / 1.59), the band without rouge's
+    // anti-aliased silhouette pixels. Studio front's band is also lifted by the temple's sheen (the map's
+    // reflection of the side lamp). Daylight front and studio 3/4 stay under 1 by the chin's underside,
+    // which the reference lights indirectly (tests/fixtures/truth/README.md).
+    {"studio", "front", 1.51, {1.028, 1.024, 1.009, 1.013, 1.014}, 1.136},
+    {"studio", "threequarter", 1.74, {1.010, 1.033, 0.946, 1.015, 1.005}, 0.991},
+    {"daylight", "front", 1.23, {0.996, 1.002, 0.999, 1.001, 1.023}, 0.994},
+    {"daylight", "threequarter", 1.39, {0.962, 0.992, 0.943, 0.981, 1.001}, 1.008},
+    {"office", "front", 1.56, {1.028, 1.033, 1.019, 0.996, 1.033}, 1.054},
+    {"office", "threequarter", 1.52, {1.018, 1.044, 1.002, 0.988, 1.022}, 1.059},
+    {"sunset", "front", 1.22, {1.056, 1.063, 1.025, 1.031, 1.090}, 1.011},
+    {"sunset", "threequarter", 1.41, {1.050, 1.053, 0.968, 1.012, 1.067}, 1.011},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
@@ -252,10 +254,11 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     int w = t->w, h = t->h;
     size_t n = (size_t)w * h;
     uint8_t *img = malloc(n * 4), *alb = malloc(n * 4), *mask = calloc(n, 1), *face_px = calloc(n, 1);
+    uint8_t *edge_px = calloc(n, 1);
     double *ro = malloc(n * 3 * sizeof(double)), *pt = malloc(n * 3 * sizeof(double));
     double *rb = malloc(n * 3 * sizeof(double)), *pb = malloc(n * 3 * sizeof(double));
     double *ratio = malloc(n * sizeof(double)), *de = calloc(n, sizeof(double));
-    bool ok = RS_CHECK(img && alb && mask && face_px && ro && pt && rb && pb && ratio && de, "out of memory");
+    bool ok = RS_CHECK(img && alb && mask && face_px && edge_px && ro && pt && rb && pb && ratio && de, "out of memory");
     rouge_view v = {.width = w, .height = h, .yaw_deg = t->yaw, .pitch_deg = t->pitch, .env = env,
                     .pipeline = ROUGE_PIPELINE_REFERENCE, .background = {0, 0, 0, 1}};
     ok = ok && render(&v, img);
@@ -329,7 +332,20 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     }
     free(rblur), free(pblur);
     res->delta_e = de_sum / (double)de_n;
-    // Region and contour luminance.
+    // Region and contour luminance. The band compares surfaces, both fully covered: the path tracer's pixel
+    // at coverage 255 (its radiance unpremultiplied), rouge's not one of its anti-aliased silhouette pixels
+    // (a face pixel with background in its 3x3, drawn at 1/2 to 7/8 over the black background,
+    // composite.frag.glsl). Counting those compared a pixel part background with one all skin: a
+    // difference of where the outline falls within a pixel (the IoU's business), not of the light; it
+    // was a quarter of the band's deficit in the front views.
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    int yy = y + dy, xx = x + dx;
+                    if (yy >= 0 && yy < h && xx >= 0 && xx < w && !face_px[(size_t)yy * w + xx])
+                        edge_px[(size_t)y * w + x] = 1;
+                }
     double reg[R_COUNT][2] = {{0}}, band[2] = {0};
     memset(res->region_px, 0, sizeof res->region_px);
     res->band_px = 0;
@@ -339,7 +355,7 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
             reg[r][0] += lum(pt + i * 3), reg[r][1] += lum(ro + i * 3);
             res->region_px[r]++;
         }
-        if ((t->label[i] & LABEL_CONTOUR) && t->alpha[i] == 255 && face_px[i]) {
+        if ((t->label[i] & LABEL_CONTOUR) && t->alpha[i] == 255 && face_px[i] && !edge_px[i]) {
             band[0] += lum(ro + i * 3), band[1] += lum(pt + i * 3);
             res->band_px++;
         }
@@ -384,7 +400,7 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
         rs_image_free(&side);
     }
 out:
-    free(img), free(alb), free(mask), free(face_px), free(ro), free(pt), free(rb), free(pb), free(ratio), free(de);
+    free(img), free(alb), free(mask), free(face_px), free(edge_px), free(ro), free(pt), free(rb), free(pb), free(ratio), free(de);
     return ok;
 }
 
