@@ -21,10 +21,17 @@ float rs_beckmann(float ndoth, float m)
     return exp((c2 - 1.0) / (c2 * m2)) / (m2 * c2 * c2);  // exp(-tan^2(a)/m^2) / (m^2 cos^4(a))
 }
 
+// x^5 by multiplication: pow() costs two transcendental ops, and the environment's composite takes
+// fifth powers some 25 times a pixel (Schlick per lobe tap, Burley's retro-reflection).
+float rs_pow5(float x)
+{
+    float x2 = x * x;
+    return x2 * x2 * x;
+}
+
 float rs_schlick(float vdoth, float f0)
 {
-    float x = 1.0 - vdoth, x2 = x * x;
-    float e = x2 * x2 * x;  // not pow(): two transcendental ops per call, 26 calls per pixel under an environment
+    float e = rs_pow5(1.0 - vdoth);
     return e + f0 * (1.0 - e);
 }
 
