@@ -223,8 +223,8 @@ static void test_look_save_killed_midway_leaves_old_or_new_look(void)
     rs_makeup *back = painted(c, "blush", 0, 0.0f);
     rs_makeup_range dirty;
     RS_CHECK(back && rs_look_load(back, path, &dirty, &err) == RS_OK, "%s", err.msg);
-    printf("# look: %d kills (%d inside a save), %d old-or-new, %d temp files left by killed saves (%zu/%zu bytes)\n", ks.kills,
-           ks.mid_save, ks.old_or_new, ks.temps, n[0], n[1]);
+    printf("# look: %d kills (%d inside a save), %d old-or-new, %d temp files left by killed saves (%zu/%zu bytes)\n",
+           ks.kills, ks.mid_save, ks.old_or_new, ks.temps, n[0], n[1]);
     // O_TMPFILE: a save killed while writing leaves no named file (the tiny link-to-rename window aside).
     RS_CHECK(ks.temps <= ks.kills / 20, "%d of %d killed saves left a temp file", ks.temps, ks.kills);
     rs_makeup_destroy(back);
@@ -338,7 +338,7 @@ static void test_kill_loop_catches_a_non_atomic_writer(void)
     memset(b, 'b', N);
     naive_ctx ctx = {{a, b}, {N, N}};
     kill_stats ks = kill_loop(scratch(), "naive.bin", save_naive, &ctx, a, N, b, N, MID_SAVE_KILLS, true);
-    RS_CHECK(ks.torn + ks.missing > 0, "no torn file in %d kills (%d inside a save): the kill loop does not test anything",
+    RS_CHECK(ks.torn + ks.missing > 0, "no torn file in %d kills (%d inside a save): the kill loop tests nothing",
              ks.kills, ks.mid_save);
     printf("# control: the first torn file after %d kills (%d inside a save) with a plain fopen/fwrite writer\n",
            ks.kills, ks.mid_save);
