@@ -14,14 +14,16 @@ export RS_TEST_OUT="$build/test-out"
 mkdir -p "$RS_TEST_OUT"
 jobs=${RS_TEST_JOBS:-$(nproc 2>/dev/null || echo 2)}
 
-# Run alone after the others: kill-timing tests whose bounds assume an otherwise idle machine.
-alone="$build/tests/test_atomic_save"
-# The slow ones first, by wall time (valgrind runs on one core) (issue 24's budgets, session 4's numbers: test_import and
-# test_env_tool.sh are cheap now); then the rest in name order; the browser test last: it mostly waits
-# on the browser, and the native tests' wall time is the one that counts.
-slow="tests/test_valgrind.sh tests/test_viewer.sh $build/tests/test_mobile $build/tests/test_truth
-      $build/tests/test_edges $build/tests/test_render $build/tests/test_fine_makeup $build/tests/test_paint_render
-      $build/tests/test_lighting tests/test_robustness.sh $build/tests/test_incremental $build/tests/test_shadow"
+# Every test shares the pool: none needs an idle machine (test_atomic_save's kill loop counts the kills
+# that land inside a save instead of running for a fixed time; it once ran alone after the pool, and so
+# waited for the browser test).
+# The slow ones first, longest first (CPU seconds of a fresh clone's run, session 5; valgrind runs on one
+# core), so that the short ones fill in beside them and both cores finish together; then the rest in name
+# order; the browser test last: it overlaps the native tests' last minute, and nothing waits for it.
+slow="tests/test_valgrind.sh tests/test_viewer.sh $build/tests/test_edges $build/tests/test_fine_makeup
+      $build/tests/test_mobile $build/tests/test_truth $build/tests/test_paint_render $build/tests/test_lighting
+      $build/tests/test_render $build/tests/test_env_specular $build/tests/test_incremental $build/tests/test_shadow
+      tests/test_robustness.sh"
 last="tests/test_web.sh"
 # One space between names: the membership tests below match " NAME " (a line break once ran test_edges twice).
 slow=$(echo $slow)
@@ -49,7 +51,7 @@ jobs_of() {
 }
 order=""
 for t in $slow; do case " $all " in *" $t "*) order="$order $(jobs_of "$t" "$@")" ;; esac; done
-for t in $all; do case " $slow $alone $last " in *" $t "*) ;; *) order="$order $(jobs_of "$t" "$@")" ;; esac; done
+for t in $all; do case " $slow $last " in *" $t "*) ;; *) order="$order $(jobs_of "$t" "$@")" ;; esac; done
 for t in $last; do case " $all " in *" $t "*) order="$order $(jobs_of "$t" "$@")" ;; esac; done
 
 # One test: its output to LOGS/NAME.log, closed by a line "# TEST: W s wall, C s CPU" (C: user + system
@@ -73,7 +75,6 @@ one='t={}; n=$(echo "$t" | tr /+ __) p=${t%%+*} args=$RS_FILTERS
 run_start=$(date +%s.%N)
 # shellcheck disable=SC2086
 printf '%s\n' $order | xargs -P "$jobs" -I{} sh -c "$one"
-for t in $alone; do case " $all " in *" $t "*) printf '%s\n' "$t" | xargs -I{} sh -c "$one" ;; esac; done
 
 status=0
 for t in $(for a in $all; do jobs_of "$a" "$@"; done); do

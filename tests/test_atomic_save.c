@@ -3,7 +3,10 @@
 // every time, the file under the target name must be byte for byte the old or the new version, never
 // a torn mix, an empty file or missing. A control runs the same loop on a plain fopen/fwrite writer and
 // must catch it tearing the file, which shows the kill loop really lands in the middle of writes.
-#define _POSIX_C_SOURCE 200809L
+// The loops run until enough kills have landed inside a save (counted in memory the child shares), not
+// for a fixed time: on a busy machine the child may not run between fork and kill, and a timed loop
+// then proves less (it once had to run alone after the other tests).
+#define _DEFAULT_SOURCE  // MAP_ANONYMOUS
 #include "support/harness.h"
 #include "formats/look.h"
 
@@ -13,18 +16,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
 
-#define KILL_SECONDS 2.0  // per test: a hundred or more kills on a 2-core machine
+#define MID_SAVE_KILLS 150  // kills that must land inside a save (the control: until a file is torn)
+#define MAX_SECONDS 60.0    // a bound for a machine too busy to let the child run; the checks then fail
 
 // What the child saves: content 0 or 1 to `path`, returning false on failure.
 typedef bool (*save_fn)(const void *ctx, int which, const char *path);
 
 typedef struct kill_stats {
     int kills;          // children killed mid-loop
+    int mid_save;       // ... while inside a save (begun, not finished)
     int old_or_new;     // target held one of the two complete versions after the kill
     int torn;           // target held anything else
     int missing;        // target absent
@@ -63,16 +69,29 @@ static int remove_temps(const char *dir, const char *base)
     return n;
 }
 
-// The kill loop. `versions` are the exact bytes of content 0 and 1; the target starts as version 0.
+// The saving child's progress, in memory it shares with the parent (read after the child is reaped).
+typedef struct progress {
+    volatile long begun, done;
+} progress;
+
+// The kill loop. `versions` are the exact bytes of content 0 and 1; the target starts as version 0. It
+// stops once `mid_save` kills have landed inside a save, or (stop_at_torn) at the first torn or missing
+// file, or after MAX_SECONDS.
 static kill_stats kill_loop(const char *dir, const char *base, save_fn save, const void *ctx, const void *v0,
-                            size_t n0, const void *v1, size_t n1, double seconds)
+                            size_t n0, const void *v1, size_t n1, int mid_save, bool stop_at_torn)
 {
     kill_stats ks = {0};
+    progress *pg = mmap(NULL, sizeof *pg, PROT_READ | PROT_WRITE, MAP_SHARED | MAP_ANONYMOUS, -1, 0);
+    if (pg == MAP_FAILED) {
+        snprintf(ks.why, sizeof ks.why, "mmap: %s", strerror(errno));
+        return ks;
+    }
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", dir, base);
     rs_error err = {0};
     if (!save(ctx, 0, path)) {
         snprintf(ks.why, sizeof ks.why, "first save failed");
+        munmap(pg, sizeof *pg);
         return ks;
     }
     // One save's duration sets the range of kill delays, so kills land anywhere in a save.
@@ -81,13 +100,18 @@ static kill_stats kill_loop(const char *dir, const char *base, save_fn save, con
     double save_us = (rs_time_now() - t0) / 3 * 1e6;
     save(ctx, 0, path);
     double start = rs_time_now();
-    while (rs_time_now() - start < seconds) {
+    while (ks.mid_save < mid_save && !(stop_at_torn && ks.torn + ks.missing > 0) &&
+           rs_time_now() - start < MAX_SECONDS) {
         fflush(NULL);
+        pg->begun = pg->done = 0;
         pid_t pid = fork();
         if (pid < 0) break;
         if (pid == 0) {
-            for (int i = 1;; i++)
+            for (int i = 1;; i++) {
+                pg->begun++;
                 if (!save(ctx, i & 1, path)) _exit(3);
+                pg->done++;
+            }
         }
         sleep_us(rand_unit() * 2.5 * save_us + 20.0);
         kill(pid, SIGKILL);
@@ -98,6 +122,7 @@ static kill_stats kill_loop(const char *dir, const char *base, save_fn save, con
             break;
         }
         ks.kills++;
+        if (pg->begun > pg->done) ks.mid_save++;
         void *data = NULL;
         size_t len = 0;
         if (rs_file_read_all(path, 1u << 28, &data, &len, &err) != RS_OK) {
@@ -114,6 +139,7 @@ static kill_stats kill_loop(const char *dir, const char *base, save_fn save, con
         free(data);
         ks.temps += remove_temps(dir, base);
     }
+    munmap(pg, sizeof *pg);
     return ks;
 }
 
@@ -186,8 +212,9 @@ static void test_look_save_killed_midway_leaves_old_or_new_look(void)
     rs_error err = {0};
     for (int i = 0; i < 2; i++) RS_REQUIRE(rs_look_write_memory(mk[i], &v[i], &n[i], &err) == RS_OK, "%s", err.msg);
     RS_REQUIRE(n[0] != n[1] || memcmp(v[0], v[1], n[0]) != 0, "the two looks are the same");
-    kill_stats ks = kill_loop(scratch(), "kill.look", save_look, mk, v[0], n[0], v[1], n[1], KILL_SECONDS);
-    RS_CHECK(ks.kills >= 20, "only %d kills (%s)", ks.kills, ks.why);
+    kill_stats ks = kill_loop(scratch(), "kill.look", save_look, mk, v[0], n[0], v[1], n[1], MID_SAVE_KILLS, false);
+    RS_CHECK(ks.mid_save >= MID_SAVE_KILLS, "only %d of %d kills inside a save in %.0f s (%s)", ks.mid_save, ks.kills,
+             MAX_SECONDS, ks.why);
     RS_CHECK(ks.torn == 0 && ks.missing == 0 && !ks.why[0], "%d torn, %d missing of %d kills: %s", ks.torn,
              ks.missing, ks.kills, ks.why);
     // The saved look must also load: replaying it gives back one of the two layers' files.
@@ -196,8 +223,8 @@ static void test_look_save_killed_midway_leaves_old_or_new_look(void)
     rs_makeup *back = painted(c, "blush", 0, 0.0f);
     rs_makeup_range dirty;
     RS_CHECK(back && rs_look_load(back, path, &dirty, &err) == RS_OK, "%s", err.msg);
-    printf("# look: %d kills, %d old-or-new, %d temp files left by killed saves (%zu/%zu bytes)\n", ks.kills,
-           ks.old_or_new, ks.temps, n[0], n[1]);
+    printf("# look: %d kills (%d inside a save), %d old-or-new, %d temp files left by killed saves (%zu/%zu bytes)\n",
+           ks.kills, ks.mid_save, ks.old_or_new, ks.temps, n[0], n[1]);
     // O_TMPFILE: a save killed while writing leaves no named file (the tiny link-to-rename window aside).
     RS_CHECK(ks.temps <= ks.kills / 20, "%d of %d killed saves left a temp file", ks.temps, ks.kills);
     rs_makeup_destroy(back);
@@ -240,12 +267,13 @@ static void test_png_save_killed_midway_leaves_old_or_new_png(void)
         RS_REQUIRE(rs_image_write_png(path, &img[i], &err) == RS_OK, "%s", err.msg);
         RS_REQUIRE(rs_file_read_all(path, 1u << 24, &v[i], &n[i], &err) == RS_OK, "%s", err.msg);
     }
-    kill_stats ks = kill_loop(scratch(), "kill.png", save_png, img, v[0], n[0], v[1], n[1], KILL_SECONDS);
-    RS_CHECK(ks.kills >= 20, "only %d kills (%s)", ks.kills, ks.why);
+    kill_stats ks = kill_loop(scratch(), "kill.png", save_png, img, v[0], n[0], v[1], n[1], MID_SAVE_KILLS, false);
+    RS_CHECK(ks.mid_save >= MID_SAVE_KILLS, "only %d of %d kills inside a save in %.0f s (%s)", ks.mid_save, ks.kills,
+             MAX_SECONDS, ks.why);
     RS_CHECK(ks.torn == 0 && ks.missing == 0 && !ks.why[0], "%d torn, %d missing of %d kills: %s", ks.torn,
              ks.missing, ks.kills, ks.why);
-    printf("# png: %d kills, %d old-or-new, %d temp files left by killed saves (%zu/%zu bytes)\n", ks.kills,
-           ks.old_or_new, ks.temps, n[0], n[1]);
+    printf("# png: %d kills (%d inside a save), %d old-or-new, %d temp files left by killed saves (%zu/%zu bytes)\n",
+           ks.kills, ks.mid_save, ks.old_or_new, ks.temps, n[0], n[1]);
     RS_CHECK(ks.temps <= ks.kills / 20, "%d of %d killed saves left a temp file", ks.temps, ks.kills);
     free(v[0]), free(v[1]);
     rs_image_free(&img[0]), rs_image_free(&img[1]);
@@ -309,9 +337,11 @@ static void test_kill_loop_catches_a_non_atomic_writer(void)
     memset(a, 'a', N);
     memset(b, 'b', N);
     naive_ctx ctx = {{a, b}, {N, N}};
-    kill_stats ks = kill_loop(scratch(), "naive.bin", save_naive, &ctx, a, N, b, N, 0.5);
-    RS_CHECK(ks.torn + ks.missing > 0, "no torn file in %d kills: the kill loop does not test anything", ks.kills);
-    printf("# control: %d of %d kills left a torn file with a plain fopen/fwrite writer\n", ks.torn, ks.kills);
+    kill_stats ks = kill_loop(scratch(), "naive.bin", save_naive, &ctx, a, N, b, N, MID_SAVE_KILLS, true);
+    RS_CHECK(ks.torn + ks.missing > 0, "no torn file in %d kills (%d inside a save): the kill loop tests nothing",
+             ks.kills, ks.mid_save);
+    printf("# control: the first torn file after %d kills (%d inside a save) with a plain fopen/fwrite writer\n",
+           ks.kills, ks.mid_save);
     free(a), free(b);
 }
 
