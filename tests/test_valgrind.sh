@@ -6,8 +6,9 @@
 # of the process and trips valgrind in places: tests/valgrind.supp suppresses only stacks that pass
 # through those libraries.
 #
-# Kept small to fit `make test` (~75 CPU-s on one core, most of them the render, and about half of the
-# render's llvmpipe drawing the mobile 2048^2 shadow map): the render uses a 3000-splat face converted here.
+# Kept small to fit `make test` (~60 CPU-s on one core, most of them the render: any GL process's start-up
+# under memcheck, then the studio environment, look and strokes; its 48x48 picture gets a 512^2 shadow
+# map): the render uses a 3000-splat face converted here.
 # RS_VALGRIND_FACE=1 (make test-full) adds the bundled 600k face at --max-splats 2000 (~90 s: loading and
 # uploading 600k splats under valgrind); docs/robustness.md records its result.
 # Usage: sh tests/test_valgrind.sh BUILD_DIR [NAME_FILTER...]   (run from the repository root)
