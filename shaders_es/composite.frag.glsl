@@ -141,7 +141,7 @@ vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, float amo
 // 1.23x over the same scene with Lambert's exit at N.V 0.2, 1.10x at 0.4, <= 2 % beyond 0.6, on both the
 // lit and unlit sides, so rouge's whole silhouette ring (skull, jaw, the nose's sides) drew 10-25 % darker.
 // It is a surface term: per pixel, times the albedo, not scattered under the skin. A light of colour e
-// (its irradiance at normal incidence) from view-space direction l:
+// (its irradiance at normal incidence) from direction l (N, l, V in one frame):
 vec3 burley_retro_light(vec3 e, vec3 N, vec3 l, vec3 V, float r, float fv)
 {
     float nl = dot(N, l);
@@ -421,9 +421,10 @@ void main()
             float fv = rs_pow5(1.0 - clamp(dot(N, V), 0.0, 1.0)), r = sqrt(max(m, 0.0));
             vec3 Er = burley_retro_light(u_key_color * shadow, N, u_key_dir, V, r, fv)
                     + burley_retro_env(N, V, r, fv, ao);
+            // The lamps' directions are in the environment's frame: N and V go there once (a rotation).
+            vec3 Ne = u_env_from_view * N, Ve = u_env_from_view * V;
             for (int i = 0; i < 3; i++)
-                Er += burley_retro_light(u_env_lamp_color[i] * vis[i], N, transpose(u_env_from_view) * u_env_lamp_dir[i],
-                                         V, r, fv);
+                Er += burley_retro_light(u_env_lamp_color[i] * vis[i], Ne, u_env_lamp_dir[i], Ve, r, fv);
             Dd += Er;
         }
         if (u_mode == MODE_DIFFUSE) c = A * Dd;

@@ -702,30 +702,44 @@ static void paint_row(bench *b, rs_gl_context *gl, const char *cosmetic, float s
     rs_render_destroy(r);
 }
 
-// Where the environment's cost goes: the same two renderers with each stage glFinish-timed (slower overall, so
-// a row of its own), the median per stage under the environment minus under the lamp.
+// The environment-cost rows' pair of renderers: [0] lit by the default environment, [1] by the paper's
+// lamp; time_stages: each stage glFinish-timed.
+static bool env_pair_create(bench *b, rs_gl_context *gl, bool time_stages, rs_renderer *r[2], rs_error *err)
+{
+    rs_env *env = NULL;
+    bool ok = rs_env_open(RS_ENV_DEFAULT, NULL, &env, err) == RS_OK;
+    for (int k = 0; ok && k < 2; k++)
+        ok = rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl), .time_stages = time_stages},
+                              &r[k], err) == RS_OK;
+    ok = ok && rs_render_set_env(r[0], env, err) == RS_OK;
+    rs_env_destroy(env);
+    return ok;
+}
+
+// A full mobile frame of the pair's renderer k, the same view for both.
+static bool env_pair_frame(rs_renderer *r[2], int k, rs_error *err)
+{
+    rs_view v = rs_view_defaults();
+    v.width = v.height = 512;
+    v.pipeline = RS_PIPELINE_MOBILE;
+    v.lighting = k == 0 ? RS_LIGHTING_ENV : RS_LIGHTING_LIGHTS;
+    rs_render_invalidate(r[k]);
+    return rs_render_frame(r[k], &v, err) == RS_OK;
+}
+
+// Where the environment's cost goes: the pair with each stage glFinish-timed (slower overall, so a row of
+// its own), the median per stage under the environment minus under the lamp.
 static void env_stage_row(bench *b, rs_gl_context *gl)
 {
     const char *what = "environment cost per stage, mobile 512x512";
     rs_renderer *r[2] = {NULL, NULL};
-    rs_env *env = NULL;
     rs_error err = {0};
-    bool ok = rs_env_open(RS_ENV_DEFAULT, NULL, &env, &err) == RS_OK;
-    for (int k = 0; ok && k < 2; k++)
-        ok = rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl), .time_stages = true},
-                              &r[k], &err) == RS_OK;
-    ok = ok && rs_render_set_env(r[0], env, &err) == RS_OK;
-    rs_env_destroy(env);
+    bool ok = env_pair_create(b, gl, true, r, &err);
     static double st[2][RS_STAGE_COUNT][64];
     int frames = RS_MIN(b->frames, 64);
     for (int i = -1; ok && i < frames; i++)
         for (int k = 0; ok && k < 2; k++) {
-            rs_view v = rs_view_defaults();
-            v.width = v.height = 512;
-            v.pipeline = RS_PIPELINE_MOBILE;
-            v.lighting = k == 0 ? RS_LIGHTING_ENV : RS_LIGHTING_LIGHTS;
-            rs_render_invalidate(r[k]);
-            ok = rs_render_frame(r[k], &v, &err) == RS_OK;
+            ok = env_pair_frame(r, k, &err);
             rs_render_stats s = rs_render_get_stats(r[k]);
             for (int j = 0; ok && i >= 0 && j < RS_STAGE_COUNT; j++) st[k][j][i] = s.stage_ms[j];
         }
@@ -747,24 +761,14 @@ static void env_row(bench *b, rs_gl_context *gl)
 {
     const char *what = "environment cost, mobile frame 512x512";
     rs_renderer *r[2] = {NULL, NULL};
-    rs_env *env = NULL;
     rs_error err = {0};
-    bool ok = rs_env_open(RS_ENV_DEFAULT, NULL, &env, &err) == RS_OK;
-    for (int k = 0; ok && k < 2; k++)
-        ok = rs_render_create(&(rs_render_desc){.cloud = b->cloud, .caps = rs_gl_get_caps(gl)}, &r[k], &err) == RS_OK;
-    ok = ok && rs_render_set_env(r[0], env, &err) == RS_OK;
-    rs_env_destroy(env);
+    bool ok = env_pair_create(b, gl, false, r, &err);
     static double ms[2][64];
     int frames = RS_MIN(b->frames, 64);
     for (int i = -1; ok && i < frames; i++)
         for (int k = 0; ok && k < 2; k++) {
-            rs_view v = rs_view_defaults();
-            v.width = v.height = 512;
-            v.pipeline = RS_PIPELINE_MOBILE;
-            v.lighting = k == 0 ? RS_LIGHTING_ENV : RS_LIGHTING_LIGHTS;
-            rs_render_invalidate(r[k]);
             double t0 = rs_time_now();
-            ok = rs_render_frame(r[k], &v, &err) == RS_OK;
+            ok = env_pair_frame(r, k, &err);
             glFinish();
             if (i >= 0) ms[k][i] = (rs_time_now() - t0) * 1000.0;
         }

@@ -32,18 +32,22 @@ static int map_size(const rs_renderer *r, const rs_frame *f, float texels_per_px
     return RS_MIN(size, r->caps.max_texture_size);
 }
 
+// Deletes a map's framebuffer and depth texture (either may be 0).
+static void drop_depth(GLuint *fbo, GLuint *tex)
+{
+    glDeleteFramebuffers(1, fbo);
+    glDeleteTextures(1, tex);
+    *fbo = *tex = 0;
+}
+
 void rs_render_shadow_release(rs_renderer *r)
 {
     for (int i = 0; i < 2; i++) {
-        rs_shadow_map *m = &r->shadow[i];
-        glDeleteFramebuffers(1, &m->fbo);
-        glDeleteTextures(1, &m->tex);
-        memset(m, 0, sizeof *m);
+        drop_depth(&r->shadow[i].fbo, &r->shadow[i].tex);
+        memset(&r->shadow[i], 0, sizeof r->shadow[i]);
     }
-    rs_lamp_shadows *l = &r->lamp_shadow;
-    glDeleteFramebuffers(1, &l->fbo);
-    glDeleteTextures(1, &l->tex);
-    memset(l, 0, sizeof *l);
+    drop_depth(&r->lamp_shadow.fbo, &r->lamp_shadow.tex);
+    memset(&r->lamp_shadow, 0, sizeof r->lamp_shadow);
 }
 
 static void depth_compare(GLenum target)
@@ -66,10 +70,7 @@ static rs_result finish_depth_fbo(GLuint *fbo, GLuint *tex, const char *what, rs
     glReadBuffer(GL_NONE);
     rs_result res = rs_render_fbo_check(what, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    if (res != RS_OK) {
-        glDeleteFramebuffers(1, fbo);
-        glDeleteTextures(1, tex);
-    }
+    if (res != RS_OK) drop_depth(fbo, tex);
     return res;
 }
 
@@ -77,8 +78,7 @@ static rs_result finish_depth_fbo(GLuint *fbo, GLuint *tex, const char *what, rs
 static rs_result ensure_map(rs_shadow_map *m, int size, rs_error *err)
 {
     if (m->tex && m->size == size) return RS_OK;
-    glDeleteFramebuffers(1, &m->fbo);
-    glDeleteTextures(1, &m->tex);
+    drop_depth(&m->fbo, &m->tex);
     memset(m, 0, sizeof *m);
     m->tex = rs_render_texture(GL_DEPTH_COMPONENT32F, size, size);
     depth_compare(GL_TEXTURE_2D);
@@ -101,8 +101,7 @@ static rs_result ensure_lamp_maps(rs_renderer *r, int size, rs_error *err)
 {
     rs_lamp_shadows *l = &r->lamp_shadow;
     if (l->tex && l->size == size) return RS_OK;
-    glDeleteFramebuffers(1, &l->fbo);
-    glDeleteTextures(1, &l->tex);
+    drop_depth(&l->fbo, &l->tex);
     memset(l, 0, sizeof *l);
     glGenTextures(1, &l->tex);
     glBindTexture(GL_TEXTURE_2D_ARRAY, l->tex);
