@@ -254,10 +254,12 @@ float reflection_open(vec3 p, vec3 R, inout ivec2 hit)
 {
     float open = 1.0;
     float d = 0.125 * u_contour_reach;
+    // The march's points in clip space are linear in d: no projection per step.
+    vec4 cp = u_proj * vec4(p, 1.0), cr = u_proj * vec4(R, 0.0);
     for (int k = 0; k < 6; k++, d *= 2.0) {
         vec3 q = p + R * d;
         if (q.z > -1e-3) break;  // passes the eye's plane: in front of everything the camera sees
-        vec4 c = u_proj * vec4(q, 1.0);
+        vec4 c = cp + cr * d;
         vec2 f = (c.xy / c.w * 0.5 + 0.5) * u_viewport;
         if (any(lessThan(f, vec2(0.0))) || any(greaterThanEqual(f, u_viewport))) break;
         vec3 s;

@@ -88,7 +88,9 @@ float rs_env_lobe_albedo(float ndotv, float m, float f0)
 // much wider than their own spread (3 x 3 taps of 0.6 of the lobe: office, studio +-25 % on a sphere), so
 // the taps' own spread is 0.75 of the lobe's across it: 3 taps across are then no wider apart than that, and
 // along the plane 5 still resolve the horizon at grazing (test_env_specular: every band within 12 %; 5 x 5
-// gave 8 % at two thirds of the cost).
+// gave 8 % at two thirds of the cost). Where the surface faces the eye (N.V >= 0.8, most of a face in
+// view) one lookup does (below): the grid's 15 taps there were two thirds of the environment's cost on
+// llvmpipe and bought under 4 % in any band.
 vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
 {
     // All in the environment's frame (a rotation of view space: the lobe's dot products are kept).
@@ -103,24 +105,30 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     vec3 t2 = cross(R, t1);
     float sigma = 1.4142 * max(m, 0.02);      // the lobe's spread along the plane, radians
     float across = clamp(ndotv, 0.0, 1.0);    // across it, relative
-    float s = max(0.75 * across, 0.2);        // the taps' own spread, relative to the lobe's
-    float d1 = min(sigma * sqrt(1.0 - s * s), 0.6);
-    float d2 = min(sigma * sqrt(2.0 * max(across * across - s * s, 0.0)), 0.6);
-    float g1 = d1 * d1 / (2.0 * sigma * sigma), g2 = d2 * d2 / (2.0 * sigma * sigma * max(across * across, 1e-4));
+    // Facing the eye the lobe is nearly round and far above the horizon, and one lookup of its whole
+    // spread (along and across averaged) does; from N.V 0.65 to 0.8 the grid's spread eases into that one
+    // lookup's, so its taps close in on R and no seam shows where their number drops.
+    float s1 = sqrt(0.5 + 0.5 * across * across), e = smoothstep(0.65, 0.8, across);
+    bool one = across >= 0.8;
+    int na = one ? 0 : 2, nc = one ? 0 : 1;
+    float va = mix(1.0, s1 * s1, e), vc = mix(across * across, s1 * s1, e);  // the variances the grid stands
+    float s = mix(max(0.75 * across, 0.2), s1, e);                           // for, relative to sigma^2
+    float d1 = min(sigma * sqrt(max(va - s * s, 0.0)), 0.6);
+    float d2 = min(sigma * sqrt(2.0 * max(vc - s * s, 0.0)), 0.6);
+    float g1 = d1 * d1 / (2.0 * sigma * sigma * va), g2 = d2 * d2 / (2.0 * sigma * sigma * max(vc, 1e-4));
     float lod = rs_env_lod(s * m);
     float fc = max(rs_ksk_lobe(N, R, V, m, f0), 1e-20);
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
     // Offsets and weights from the loop counters alone: a small local array indexed by them cost the H100
-    // an eighth of the environment's time (it went to local memory). The loops run 5 x 5 and skip the
-    // outer columns across: written as 5 x 3, Mesa unrolled them (at each of this function's three call
-    // sites) and llvmpipe's compile of the composite took three times as long (4.5 -> 14 CPU-s per cold
-    // process); a GPU's compiler drops the skipped taps or spends a branch on each.
-    for (int i = -2; i <= 2; i++) {
+    // an eighth of the environment's time (it went to local memory). The bounds vary per pixel, so no
+    // compiler unrolls the loops (constant 5 x 3 bounds, unrolled by Mesa at this function's three call
+    // sites, tripled llvmpipe's compile of the composite), and a block of pixels facing the eye runs once.
+    float b = tan(d2);  // tan(j d2) = j tan(d2) for j in -1..1
+    for (int i = -na; i <= na; i++) {
         float a = tan(float(i) * d1);
-        for (int j = -2; j <= 2; j++) {
-            if (j * j > 1) continue;
-            vec3 l = normalize(R + t1 * a + t2 * tan(float(j) * d2));
+        for (int j = -nc; j <= nc; j++) {
+            vec3 l = normalize(R + t1 * a + t2 * (float(j) * b));
             float f = rs_ksk_lobe(N, l, V, m, f0);
             if (f <= 0.0) continue;
             // Binomial weights ([1 4 6 4 1] along, [1 2 1] across) times the real lobe over the Gaussian
