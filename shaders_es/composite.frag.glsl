@@ -1,8 +1,8 @@
 #version 300 es
 // composite.frag.glsl — stage 5: normalises the accumulated attributes (albedo A, normal N, m, rho_s,
 // ambient occlusion, clear coat, flakes), evaluates the specular S per pixel (Kelemen/Szirmay-Kalos: the
-// shadowed key light, the unshadowed fill, the environment's prefiltered radiance less what the shadow
-// maps of its other lamps hide), reads the diffuse D
+// shadowed key light, the unshadowed fill, the environment's prefiltered radiance and its other lamps,
+// shadowed), reads the diffuse D
 // of stage 4, and composes F = A (D + S) (paper eq. 1) or F = A D + S, then adds the makeup's untinted
 // clear coat and its flakes; then exposure, the filmic curve (or a clamp) and the sRGB encoding. Also the
 // debug views (render.h rs_render_mode). The makeup's fine layer (narrow brushes) is composed here per
@@ -85,7 +85,7 @@ vec4 flake_hash(ivec3 c)
 #define FLAKE_M 0.08
 #define FLAKE_FILL 0.35
 #define FLAKE_REFLECTANCE 0.35  // a pearl (mica / TiO2) flake's reflectance at its colour
-vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, float amount)
+vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, vec3 vis, float spread, float amount)
 {
     float cover = FLAKE_FILL * amount;
     if (cover <= 0.0) return vec3(0.0);
@@ -128,7 +128,7 @@ vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, float amo
         g = lambda > 1e-6 ? max(n, 0.0) / lambda : 0.0;
     }
     vec3 s3 = u_key_color * (key * g);
-    if (u_env_on > 0.5) s3 += rs_env_specular(N, V, me, 1.0) * ao;
+    if (u_env_on > 0.5) s3 += rs_env_specular(N, V, me, 1.0) * ao + rs_env_lamp_specular(N, V, me, 1.0, vis, spread);
     return s3 * (tint * (FLAKE_REFLECTANCE * cover));
 }
 
@@ -285,6 +285,21 @@ vec3 skin_at(ivec2 q)
     return a.rgb / a.a * (d.rgb + u_delta_weight * d.a);
 }
 
+// How far the normal turns across this pixel (radians): the larger of its changes to the next pixel right
+// and up, where those are surface (at a rim the pixel spans a few degrees of a curved surface).
+float normal_spread(ivec2 px, vec3 N)
+{
+    float d = 0.0;
+    for (int i = 0; i < 2; i++) {
+        ivec2 q = min(px + ivec2(1 - i, i), ivec2(u_viewport) - 1);
+        vec4 a = texelFetch(u_attr0, q, 0);
+        if (a.a <= u_min_weight) continue;
+        vec3 nq = normalize(texelFetch(u_attr1, q, 0).xyz / a.a * 2.0 - 1.0);
+        d = max(d, acos(clamp(dot(N, nq), -1.0, 1.0)));
+    }
+    return d;
+}
+
 bool uncovered(ivec2 q)
 {
     return texelFetch(u_attr0, clamp(q, ivec2(0), ivec2(u_viewport) - 1), 0).a <= u_min_weight;
@@ -355,6 +370,7 @@ void main()
         // The makeup's clear coat: the same lobe family, smooth (m 0.1), F0 0.04, untinted, on top.
         const float mc = 0.1;
         vec3 C = vec3(0.0), Eb = vec3(0.0), vis = vec3(1.0);
+        float spread = 0.0;
         if (coat > 0.0)
             C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
                                * shadow);
@@ -367,13 +383,15 @@ void main()
             float open_r = reflection_open(p, reflect(-V, N), hit_r);
             float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
+            spread = normal_spread(px, N);
             E += rs_env_irradiance(N) * ao + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
             Eb = rs_bounce(ao, A);
-            // The map's reflection less the lamps that this point's shadow maps hide.
-            S += max(rs_env_specular(N, V, m, RS_F0_SKIN) - rs_env_lamp_specular_hidden(N, V, m, RS_F0_SKIN, vis),
-                     vec3(0.0)) * (rho_s * so);
+            // The map's reflection and the lamps' (those as their shadow maps let them through; the sky
+            // occlusion too, as for the map: the lamps' maps are too coarse for an ear's folds, issue 22).
+            S += (rs_env_specular(N, V, m, RS_F0_SKIN) + rs_env_lamp_specular(N, V, m, RS_F0_SKIN, vis, spread))
+                 * (rho_s * so);
             // Where the face blocks it, the reflection shows the skin it runs into: the blocker that takes
             // the larger share (one lookup of a distant pixel, not two: on a GPU they cost an eighth of the
             // environment's time), and only where the share is worth one (a few % of a reflection that is a
@@ -383,12 +401,11 @@ void main()
             if (wc + wr > 0.02 && hit.x >= 0)
                 S += skin_at(hit) * ((wc + wr) * ao * rho_s * rs_env_lobe_albedo(max(ndotv, 1e-4), m, RS_F0_SKIN));
             if (coat > 0.0)
-                C += max(rs_env_specular(N, V, mc, RS_F0_COAT) - rs_env_lamp_specular_hidden(N, V, mc, RS_F0_COAT, vis),
-                         vec3(0.0)) * so;
+                C += rs_env_specular(N, V, mc, RS_F0_COAT) * so + rs_env_lamp_specular(N, V, mc, RS_F0_COAT, vis, spread);
         }
         C *= coat;
         // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).
-        if (shimmer > 0.0) C += flakes(p, N, V, A / max(max(A.r, max(A.g, A.b)), 0.05), shadow, ao, shimmer);
+        if (shimmer > 0.0) C += flakes(p, N, V, A / max(max(A.r, max(A.g, A.b)), 0.05), shadow, ao, vis, spread, shimmer);
         // The Gaussians too narrow to draw take the pixel's own irradiance. At an occluding contour or a
         // crease (nostril rim, lid fold) that pixel sees a sliver of surface edge-on, whose interpolated
         // normal can turn fully away from (or into) the light: one pixel's E drops to 0 while every drawn

@@ -3,13 +3,13 @@
 // mirror direction, prefiltered with the lobe's Beckmann roughness, times the lobe's directional albedo
 // from a lookup table; render_env.c). Directions arrive in view space and turn into the environment's
 // frame (the face frame, rotated by --env-rotate) through u_env_from_view. The environment's other compact
-// lamps are lit exactly and shadow-mapped: shadow_lookup.glsl comes first.
+// lamps are lit and reflected exactly and shadow-mapped: shadow_lookup.glsl comes first.
 uniform float u_env_on;             // 0: no environment (key/fill/ambient only)
 uniform mat3 u_env_from_view;
 uniform vec3 u_env_sh[9];           // irradiance / pi, times the environment's exposure normalisation
 uniform vec3 u_env_lamp_dir[3];     // the other compact lamps (render_env.c find_lamps): taken out of the
-uniform vec3 u_env_lamp_color[3];   // SH, lit exactly and shadowed; colour 0 when unused; the map keeps
-uniform float u_env_lamp_widen[3];  // them for the reflections; half their angular radius, radians
+uniform vec3 u_env_lamp_color[3];   // SH and the map, lit and reflected exactly and shadowed; colour 0
+uniform float u_env_lamp_widen[3];  // when unused; half their angular radius, radians
 uniform highp sampler2D u_env_map;  // RGB9E5 equirect, level k prefiltered with roughness u_env_m[k]
 uniform float u_env_m[8];
 uniform int u_env_levels;
@@ -143,16 +143,34 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     return L * rs_env_lobe_albedo(ndotv, m, f0);
 }
 
-// The share of rs_env_specular that the lamps hidden from this point (1 - vis) would reflect: each lamp as
-// the key light is drawn, a directional light whose angular size widens the lobe (roughness in
-// quadrature). The map keeps the lamps, so their shadows take this much out of its reflection.
-vec3 rs_env_lamp_specular_hidden(vec3 N_view, vec3 V_view, float m, float f0, vec3 vis)
+// The lamps' reflection (the map has them taken out, render_env.c lamp_free_levels): each lamp as the key
+// light is drawn, a directional light whose angular size widens the lobe (roughness in quadrature), times
+// what its shadow map lets through (vis). A lamp is a disc, not a point: one that straddles the surface's
+// horizon still shows its upper part, and a lobe seen at grazing makes that bright (a sphere's rim under
+// studio's back lamp read -49 % of the exact integral when the lamp ended with its centre at the horizon).
+// There the disc is taken as 4 strips parallel to the horizon (chord-length weights), those above it
+// reflected. The pixel sees a range of normals (spread: radians, the normal's change across the pixel, a
+// few degrees at a rim, as much as a lamp's radius), so the horizon sweeps over that much more of the lamp.
+// The shadow map knows nothing of a lamp behind the surface's plane (vis holds the attached shadow, 0
+// there), so such a lamp's upper part counts as lit.
+vec3 rs_env_lamp_specular(vec3 N_view, vec3 V_view, float m, float f0, vec3 vis, float spread)
 {
     vec3 N = u_env_from_view * N_view, V = u_env_from_view * V_view, s = vec3(0.0);
     for (int i = 0; i < 3; i++) {
-        if (vis[i] >= 1.0) continue;
-        float w = u_env_lamp_widen[i];
-        s += u_env_lamp_color[i] * (rs_ksk_lobe(N, u_env_lamp_dir[i], V, sqrt(m * m + w * w), f0) * (1.0 - vis[i]));
+        vec3 L = u_env_lamp_dir[i];
+        float w = u_env_lamp_widen[i], e = dot(N, L);  // e: ~ the lamp's centre's elevation
+        float r = sqrt(4.0 * w * w + spread * spread);  // its radius (2 w), and the normals' sweep
+        if (e <= -r) continue;
+        float mw = sqrt(m * m + w * w), f = 0.0, fw = 0.0;
+        int strips = e < r ? 4 : 1;  // a bound per pixel: no compiler unrolls this at each call site
+        for (int k = 0; k < strips; k++) {
+            float t = strips == 1 ? 0.0 : (float(k) - 1.5) * 0.5, wt = sqrt(1.0 - t * t);
+            vec3 Ls = normalize(L + N * (t * r));
+            fw += wt;
+            if (dot(N, Ls) > 0.0) f += wt * rs_ksk_lobe(N, Ls, V, mw, f0);
+        }
+        float v = min(vis[i] + (1.0 - smoothstep(0.0, 0.08, e)), 1.0);  // rs_lamp_shadow's attached term undone
+        s += u_env_lamp_color[i] * (f / fw * v);
     }
     return s;
 }

@@ -104,17 +104,20 @@ static int cmp_float(const void *a, const void *b)
 // over the surround, (1/pi) sum excess dw at the excess-weighted mean direction. A lamp that carries less
 // than 5 % of the map's mean irradiance is not worth it and ends the search. Each one's SH projection
 // (a directional light of colour c: sh_k = pi a_l c Y_k(d), a_l = 1, 2/3, 1/4) leaves the SH, and the
-// shader adds it exactly, shadow-mapped (env_light.glsl, render_shadow.c). The map itself keeps them: the
-// specular reflects them, less what their shadows hide (their angular size widens that share's lobe).
-static void find_lamps(const rs_env *env, rs_render_env *e)
+// shader adds it exactly, shadow-mapped (env_light.glsl, render_shadow.c). The specular reflects them
+// exactly too (env_light.glsl rs_env_lamp_specular): rgb, level 0 of the map decoded, comes back without
+// them (each region's texels down to its surround), and lamp_free_levels takes them out of the coarser
+// levels. False when out of memory.
+static bool find_lamps(const rs_env *env, rs_render_env *e, float *rgb)
 {
     const rs_env_level *lv = &env->levels[0];
     int w = lv->width, h = lv->height;
     size_t n = (size_t)w * h;
-    float *rgb = malloc(sizeof(float) * 3 * n), *lum = malloc(sizeof(float) * n), *dir = malloc(sizeof(float) * 3 * n);
+    float *lum = malloc(sizeof(float) * n), *dir = malloc(sizeof(float) * 3 * n);
     float *sorted = malloc(sizeof(float) * n);
     double *sr = malloc(sizeof(double) * (size_t)h);
-    if (!rgb || !lum || !dir || !sorted || !sr) goto done;
+    bool ok = lum && dir && sorted && sr;
+    if (!ok) goto done;
     for (int j = 0; j < h; j++) {
         double t0 = PI * j / h, t1 = PI * (j + 1) / h, th = PI * (j + 0.5) / h;
         sr[j] = 2.0 * PI / w * (cos(t0) - cos(t1));
@@ -155,9 +158,7 @@ static void find_lamps(const rs_env *env, rs_render_env *e)
             for (int q = 0; q < 3; q++) {
                 ex[q] = RS_MAX(rgb[3 * t + q] - ring[q], 0.0);
                 col[q] += ex[q] * dw;
-                rgb[3 * t + q] = (float)RS_MIN((double)rgb[3 * t + q], ring[q]);
             }
-            lum[t] = LUM(rgb + 3 * t);
             double le = LUM(ex) * dw;
             lsum += le;
             for (int q = 0; q < 3; q++) d[q] += le * dir[3 * t + q];
@@ -166,6 +167,13 @@ static void find_lamps(const rs_env *env, rs_render_env *e)
         double dl = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
         for (int q = 0; q < 3; q++) col[q] /= PI;
         if (dl <= 0 || LUM(col) < 0.05 * mean) break;
+        // A lamp: its region's texels keep only the surround (the next lamp is looked for without it).
+        for (size_t t = 0; t < n; t++) {
+            float c = pd[0] * dir[3 * t] + pd[1] * dir[3 * t + 1] + pd[2] * dir[3 * t + 2];
+            if (c < cos_region || lum[t] <= thr) continue;
+            for (int q = 0; q < 3; q++) rgb[3 * t + q] = (float)RS_MIN((double)rgb[3 * t + q], ring[q]);
+            lum[t] = LUM(rgb + 3 * t);
+        }
         float ld[3] = {(float)(d[0] / dl), (float)(d[1] / dl), (float)(d[2] / dl)}, y[9];
         rs_env_sh_basis(ld, y);
         static const float band[9] = {1.0f, 2.0f / 3, 2.0f / 3, 2.0f / 3, 0.25f, 0.25f, 0.25f, 0.25f, 0.25f};
@@ -174,14 +182,79 @@ static void find_lamps(const rs_env *env, rs_render_env *e)
         for (int q = 0; q < 3; q++) e->lamp_dir[k][q] = ld[q], e->lamp_color[k][q] = (float)col[q];
         // Its angular radius as rouge-env measures the key's (a uniform disc's, sqrt(2 <theta^2>)), about
         // the mean direction: <theta^2> ~ 2 (1 - <cos theta>), and <cos theta> = |d| / sum of the weights.
-        e->lamp_angle[k] = 2.0f * sqrtf((float)RS_MAX(1.0 - dl / RS_MAX(lsum, 1e-30), 0.0));
+        // Level 0 is prefiltered (m0): its lobe, exp(-theta^2 / (4 m0^2)), adds 4 m0^2 to <theta^2>, as much
+        // as a studio lamp's own (a 10 deg blob for a 3 deg lamp, which then reflected over the horizon).
+        double t2 = 4.0 * RS_MAX(1.0 - dl / RS_MAX(lsum, 1e-30), 0.0) - 8.0 * (double)env->level_m[0] * env->level_m[0];
+        e->lamp_angle[k] = (float)sqrt(RS_MAX(t2, 1e-4));
     }
 done:
-    free(rgb);
     free(lum);
     free(dir);
     free(sorted);
     free(sr);
+    return ok;
+}
+
+// The prefilter's lobe (tools/env/env_bake.c, N = V = R) at R.l = x for roughness m, and its integral over
+// the sphere: a lamp of power P (the integral of its radiance) adds P lobe(R.d) / integral at R.
+static double prefilter_lobe(double x, double m)
+{
+    if (x <= 0.0) return 0.0;
+    double c2 = 0.5 * (1.0 + x);
+    return exp(-(1.0 - x) / (1.0 + x) / (m * m)) / (c2 * c2) * x;
+}
+
+static double prefilter_integral(double m)
+{
+    enum { STEPS = 2048 };
+    double s = 0.0;
+    for (int i = 0; i < STEPS; i++) s += prefilter_lobe((i + 0.5) / STEPS, m);
+    return 2.0 * PI * s / STEPS;  // dw = 2 pi d(cos) about R
+}
+
+// The map the shaders reflect, without the lamps find_lamps found (they are reflected exactly, shadowed,
+// env_light.glsl: in the map, the blur of the prefilter and of the specular's taps spread a lamp that lies
+// below a surface's horizon over it, the wet sheen studio's back lamp drew on the temple, issue 22). Level 0
+// is rgb0 (find_lamps took each lamp's region down to its surround); each coarser level loses each lamp as
+// a point of its power through the level's lobe, widened by the lamp's size as the shader widens its
+// reflection. Each level's texels in out[k] (one allocation, freed by the caller). False when out of memory.
+static bool lamp_free_levels(const rs_env *env, const rs_render_env *e, const float *rgb0, uint32_t **out)
+{
+    size_t total = 0;
+    for (int k = 0; k < env->level_count; k++) total += (size_t)env->levels[k].width * env->levels[k].height;
+    uint32_t *buf = malloc(total * sizeof *buf);
+    if (!buf) return false;
+    for (int k = 0; k < env->level_count; k++) {
+        const rs_env_level *lv = &env->levels[k];
+        out[k] = buf;
+        buf += (size_t)lv->width * lv->height;
+        double norm[RS_ENV_LAMPS] = {0};
+        for (int i = 0; k > 0 && i < RS_ENV_LAMPS; i++) {
+            double wid = 0.5 * e->lamp_angle[i], m = sqrt((double)env->level_m[k] * env->level_m[k] + wid * wid);
+            norm[i] = LUM(e->lamp_color[i]) > 0 ? PI / prefilter_integral(m) : 0.0;  // power = pi x colour
+        }
+        for (int j = 0; j < lv->height; j++)
+            for (int t = 0; t < lv->width; t++) {
+                size_t at = (size_t)j * lv->width + t;
+                float c[3];
+                if (k == 0) {
+                    memcpy(c, rgb0 + 3 * at, sizeof c);
+                } else {
+                    rs_rgb9e5_unpack(lv->rgb9e5[at], c);
+                    float R[3], uv[2] = {(t + 0.5f) / lv->width, (j + 0.5f) / lv->height};
+                    rs_env_uv_to_dir(uv, R);
+                    for (int i = 0; i < RS_ENV_LAMPS; i++) {
+                        if (norm[i] <= 0) continue;
+                        const float *d = e->lamp_dir[i];
+                        double wid = 0.5 * e->lamp_angle[i], m = sqrt((double)env->level_m[k] * env->level_m[k] + wid * wid);
+                        double f = norm[i] * prefilter_lobe(R[0] * d[0] + R[1] * d[1] + R[2] * d[2], m);
+                        for (int q = 0; q < 3; q++) c[q] = (float)RS_MAX(c[q] - f * e->lamp_color[i][q], 0.0);
+                    }
+                }
+                out[k][at] = rs_rgb9e5_pack(c);
+            }
+    }
+    return true;
 }
 
 // Mean irradiance (SH + the dominant light + `lamps` more lamps) of the skin facing direction fwd
@@ -238,13 +311,26 @@ rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
     if (w > r->caps.max_texture_size || h > r->caps.max_texture_size)
         return rs_fail(err, RS_ERR_GL, "render: environment %s: %dx%d exceeds the GPU's %d", env->name, w, h,
                        r->caps.max_texture_size);
+    rs_render_env *e = &r->env;
+    float *rgb0 = malloc(sizeof(float) * 3 * (size_t)w * h);
+    uint32_t *level[RS_ENV_MAX_LEVELS] = {NULL};
+    bool ok = rgb0 != NULL;
+    memcpy(e->sh, env->sh, sizeof e->sh);  // find_lamps takes the lamps out of it
+    for (size_t t = 0; ok && t < (size_t)w * h; t++) rs_rgb9e5_unpack(env->levels[0].rgb9e5[t], rgb0 + 3 * t);
+    ok = ok && find_lamps(env, e, rgb0) && lamp_free_levels(env, e, rgb0, level);
+    free(rgb0);
+    if (!ok) {
+        memset(e, 0, sizeof *e);
+        return rs_fail(err, RS_ERR_NOMEM, "render: environment %s: out of memory", env->name);
+    }
     glGenTextures(1, &r->env_tex);
     glBindTexture(GL_TEXTURE_2D, r->env_tex);
     glTexStorage2D(GL_TEXTURE_2D, env->level_count, GL_RGB9_E5, w, h);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     for (int k = 0; k < env->level_count; k++)
         glTexSubImage2D(GL_TEXTURE_2D, k, 0, 0, env->levels[k].width, env->levels[k].height, GL_RGB,
-                        GL_UNSIGNED_INT_5_9_9_9_REV, env->levels[k].rgb9e5);
+                        GL_UNSIGNED_INT_5_9_9_9_REV, level[k]);
+    free(level[0]);  // the one allocation
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);  // longitude wraps
@@ -255,17 +341,15 @@ rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
     if (res != RS_OK) {
         glDeleteTextures(1, &r->env_tex);
         r->env_tex = 0;
+        memset(e, 0, sizeof *e);
         return res;
     }
-    rs_render_env *e = &r->env;
     e->on = true;
     const float fwd[3] = {0.0f, 0.0f, 1.0f};  // the face frame's forward: the face seen from the front
     float fe[3];
     facing_irradiance(env->sh, env->light_dir, env->light_color, NULL, NULL, 0, fwd, fe);  // lamps still in the SH
     float front = LUM(fe);
     e->scale = front > 1e-6f ? ENV_TARGET_FRONT / front : 1.0f;
-    memcpy(e->sh, env->sh, sizeof e->sh);
-    find_lamps(env, e);
     for (int k = 0; k < 9; k++)
         for (int c = 0; c < 3; c++) e->sh[k][c] *= e->scale;
     for (int k = 0; k < RS_ENV_LAMPS; k++)

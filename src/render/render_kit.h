@@ -81,10 +81,10 @@ typedef struct rs_render_env {
     float light_color[3];
     float light_angle;           // radians
     // The environment's other compact lamps (render_env.c find_lamps): taken out of sh, lit exactly and
-    // shadow-mapped (render_shadow.c); colour 0 where unused. The map keeps them for the reflections.
+    // shadow-mapped (render_shadow.c), and out of the uploaded map: reflected exactly; colour 0 where unused.
     float lamp_dir[RS_ENV_LAMPS][3];
     float lamp_color[RS_ENV_LAMPS][3];
-    float lamp_angle[RS_ENV_LAMPS];  // angular radius, radians (their share of the reflections)
+    float lamp_angle[RS_ENV_LAMPS];  // angular radius, radians (their reflections' size)
     int levels;
     float level_m[RS_ENV_MAX_LEVELS];
 } rs_render_env;
