@@ -14,7 +14,10 @@
 // is not met the test guards the number measured when the fixtures were made (the `was` table) against
 // regressions and reports the goal as a skip. Also checked: the silhouettes agree (IoU) and rouge's albedo
 // view matches the path tracer's albedo, so a mismatch there is not mistaken for lighting.
-// rouge | path tracer | dE map PNGs go to the test output folder (truth_ENV_VIEW.png).
+// rouge | path tracer | dE map | band map PNGs go to the test output folder (truth_ENV_VIEW.png); the band
+// map shows rouge / path tracer per band pixel over rouge's grey luminance: blue where rouge is darker,
+// red where brighter, full colour at 25 %. The band is also split at the lips' lowest row: under the jaw
+// (the jaw's and chin's underside and the neck's edges) and above it (scalp, ears, face outline, nose).
 #include "support/harness.h"
 #include "gl/gl.h"
 #include "rouge.h"
@@ -234,8 +237,9 @@ static void heat(double de, uint8_t *p)
 
 typedef struct result {
     double k, iou, albedo_diff, delta_e, ratio[R_COUNT], band;
+    double band_low, band_high;  // the band below the lips' lowest row (under the jaw) and above it
     double forehead, highlights;  // path tracer / rouge: specular-dominated areas (diagnostics, not goals)
-    int region_px[R_COUNT], band_px;
+    int region_px[R_COUNT], band_px, band_low_px;
 } result;
 
 static int region_of(uint8_t label)
@@ -347,9 +351,17 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
                     if (yy >= 0 && yy < h && xx >= 0 && xx < w && !face_px[(size_t)yy * w + xx])
                         edge_px[(size_t)y * w + x] = 1;
                 }
-    double reg[R_COUNT][2] = {{0}}, band[2] = {0};
+    double reg[R_COUNT][2] = {{0}}, band[2] = {0}, band_low[2] = {0};
     memset(res->region_px, 0, sizeof res->region_px);
-    res->band_px = 0;
+    res->band_px = res->band_low_px = 0;
+    size_t jaw_row = n;  // first pixel index below the lips' lowest row (n: no lips in view)
+    for (size_t i = 0; i < n; i++)
+        if (region_of(t->label[i]) == R_LIPS) jaw_row = (i / (size_t)w + 1) * (size_t)w;
+    uint8_t *in_band = calloc(n, 1);
+    if (!RS_CHECK(in_band, "out of memory")) {
+        ok = false;
+        goto out;
+    }
     for (size_t i = 0; i < n; i++) {
         int r = region_of(t->label[i]);
         if (r >= 0 && mask[i]) {
@@ -359,6 +371,8 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
         if ((t->label[i] & LABEL_CONTOUR) && t->alpha[i] == 255 && face_px[i] && !edge_px[i]) {
             band[0] += lum(ro + i * 3), band[1] += lum(pt + i * 3);
             res->band_px++;
+            in_band[i] = 1;
+            if (i >= jaw_row) band_low[0] += lum(ro + i * 3), band_low[1] += lum(pt + i * 3), res->band_low_px++;
         }
     }
     for (int r = 0; r < R_COUNT; r++) res->ratio[r] = reg[r][1] > 0 ? reg[r][0] / reg[r][1] : 0.0;
@@ -383,23 +397,36 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     res->forehead = fh[1] > 0 ? fh[0] / fh[1] : 0.0;
     res->highlights = hl[1] > 0 ? hl[0] / hl[1] : 0.0;
     res->band = band[1] > 0 ? band[0] / band[1] : 0.0;
-    // rouge | path tracer | dE (both over black).
+    res->band_low = band_low[1] > 0 ? band_low[0] / band_low[1] : 0.0;
+    res->band_high = band[1] - band_low[1] > 0 ? (band[0] - band_low[0]) / (band[1] - band_low[1]) : 0.0;
+    // rouge | path tracer | dE | band map (all over black).
     rs_image side = {0};
-    if (rs_image_create(3 * w, h, 3, &side, NULL) == RS_OK) {
+    if (rs_image_create(4 * w, h, 3, &side, NULL) == RS_OK) {
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
                 size_t i = (size_t)y * w + x;
-                uint8_t *o = side.pixels + ((size_t)y * 3 * w + x) * 3;
+                uint8_t *o = side.pixels + ((size_t)y * 4 * w + x) * 3;
                 double a = t->alpha[i] / 255.0;
                 for (int c = 0; c < 3; c++) {
                     o[c] = img[i * 4 + c];
                     o[3 * w + c] = (uint8_t)lround(255 * pb[i * 3 + c] * a);
                 }
                 heat(mask[i] ? de[i] : 0.0, o + 6 * w);
+                uint8_t *b = o + 9 * w;
+                double lp = lum(pt + i * 3), g = 0.5 * srgb_encode(lum(ro + i * 3));
+                if (in_band[i] && lp > 1e-4) {
+                    double d = fmin(fmax((lum(ro + i * 3) / lp - 1.0) / 0.25, -1.0), 1.0);
+                    b[0] = (uint8_t)lround(255 * (d < 0 ? 1.0 + d : 1.0));
+                    b[1] = (uint8_t)lround(255 * (1.0 - fabs(d)));
+                    b[2] = (uint8_t)lround(255 * (d > 0 ? 1.0 - d : 1.0));
+                } else {
+                    b[0] = b[1] = b[2] = face_px[i] ? (uint8_t)lround(255 * g) : 0;
+                }
             }
         rs_test_save(png_name, &side);
         rs_image_free(&side);
     }
+    free(in_band);
 out:
     free(img), free(alb), free(mask), free(face_px), free(edge_px), free(ro), free(pt), free(rb), free(pb), free(ratio), free(de);
     return ok;
@@ -422,8 +449,9 @@ static void test_view(void)
            ref->env, ref->view, r.k, r.iou, r.albedo_diff, r.delta_e);
     for (int i = 0; i < R_COUNT; i++)
         if (r.region_px[i] >= 20) printf(" %s %.3f", region_names[i], r.ratio[i]);
-    printf("; contour band rouge / path tracer %.3f (%d px); specular areas, path tracer / rouge: forehead %.3f"
-           " highlights %.3f\n", r.band, r.band_px, r.forehead, r.highlights);
+    printf("; contour band rouge / path tracer %.3f (%d px: under the jaw %.3f, %d px; above it %.3f); specular"
+           " areas, path tracer / rouge: forehead %.3f highlights %.3f\n", r.band, r.band_px, r.band_low,
+           r.band_low_px, r.band_high, r.forehead, r.highlights);
     // The fixture is the scene rouge renders: same camera and outline, same albedo.
     RS_CHECK(r.iou >= 0.98, "silhouettes differ: IoU %.4f", r.iou);
     // albedo_diff -1: not checked under this environment.
