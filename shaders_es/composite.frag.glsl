@@ -128,7 +128,7 @@ vec3 flakes(vec3 p, vec3 N, vec3 V, vec3 tint, float shadow, float ao, vec3 vis,
         g = lambda > 1e-6 ? max(n, 0.0) / lambda : 0.0;
     }
     vec3 s3 = u_key_color * (key * g);
-    if (u_env_on > 0.5) s3 += rs_env_specular(N, V, me, 1.0) * ao + rs_env_lamp_specular(N, V, me, 1.0, vis, spread);
+    if (u_env_on > 0.5) s3 += (rs_env_specular(N, V, me, 1.0) + rs_env_lamp_specular(N, V, me, 1.0, vis, spread)) * ao;
     return s3 * (tint * (FLAKE_REFLECTANCE * cover));
 }
 
@@ -388,6 +388,11 @@ void main()
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
             Eb = rs_bounce(ao, A);
+            // The lobe's share the occlusion hides (1 - ao) reflects that skin too, not black: Eb is its
+            // radiance over the hidden share, (1 - ao) L_skin, so that share adds Eb times the lobe's albedo
+            // (under the jaw: the lit neck; its shares below come to 1 with so and the blocked (wc + wr) ao).
+            float lobe = rho_s * rs_env_lobe_albedo(max(ndotv, 1e-4), m, RS_F0_SKIN);
+            S += Eb * lobe;
             // The map's reflection and the lamps' (those as their shadow maps let them through; the sky
             // occlusion too, as for the map: the lamps' maps are too coarse for an ear's folds, issue 22).
             S += (rs_env_specular(N, V, m, RS_F0_SKIN) + rs_env_lamp_specular(N, V, m, RS_F0_SKIN, vis, spread))
@@ -399,9 +404,9 @@ void main()
             float wc = 1.0 - open_c, wr = open_c * (1.0 - open_r);
             ivec2 hit = wc >= wr ? hit_c : hit_r;
             if (wc + wr > 0.02 && hit.x >= 0)
-                S += skin_at(hit) * ((wc + wr) * ao * rho_s * rs_env_lobe_albedo(max(ndotv, 1e-4), m, RS_F0_SKIN));
+                S += skin_at(hit) * ((wc + wr) * ao * lobe);
             if (coat > 0.0)
-                C += rs_env_specular(N, V, mc, RS_F0_COAT) * so + rs_env_lamp_specular(N, V, mc, RS_F0_COAT, vis, spread);
+                C += (rs_env_specular(N, V, mc, RS_F0_COAT) + rs_env_lamp_specular(N, V, mc, RS_F0_COAT, vis, spread)) * so;
         }
         C *= coat;
         // Flakes reflect in the pigment's colour (a metallic tint, normalised to keep their brightness).

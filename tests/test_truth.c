@@ -55,16 +55,19 @@ static const measured was[] = {
     // 1.91 / 1.86, daylight 1.67 / 1.46, office 1.85 / 1.59, sunset 1.78 / 1.59) and the specular's 5 x 3
     // taps (env_light.glsl: studio front's temple sheen fainter, its dE 1.51 -> 1.58), the band without rouge's
     // anti-aliased silhouette pixels. Studio front's band is also lifted by the temple's sheen (the map's
-    // reflection of the side lamp). Daylight front and studio 3/4 stay under 1 by the chin's underside,
-    // which the reference lights indirectly (tests/fixtures/truth/README.md).
-    {"studio", "front", 1.58, {1.030, 1.023, 1.006, 1.014, 1.014}, 1.137},
-    {"studio", "threequarter", 1.73, {1.009, 1.032, 0.960, 1.014, 1.003}, 0.988},
-    {"daylight", "front", 1.23, {0.997, 1.002, 0.999, 1.002, 1.021}, 0.993},
-    {"daylight", "threequarter", 1.39, {0.962, 0.993, 0.943, 0.981, 1.000}, 1.008},
-    {"office", "front", 1.56, {1.027, 1.034, 1.018, 0.998, 1.029}, 1.053},
-    {"office", "threequarter", 1.54, {1.021, 1.045, 1.002, 0.989, 1.024}, 1.058},
-    {"sunset", "front", 1.23, {1.057, 1.063, 1.025, 1.031, 1.090}, 1.011},
-    {"sunset", "threequarter", 1.41, {1.050, 1.053, 0.968, 1.012, 1.067}, 1.010},
+    // reflection of the side lamp). Then the lobe's occluded share reflecting the skin around (the bounce,
+    // composite.frag.glsl): dE 0.01-0.05 lower in every view, bands +0.000-0.003 (office 3/4 -0.001),
+    // rouge ~1 % brighter under the chin and at the ears in daylight 3/4. Daylight front and studio 3/4 stay
+    // under 1 by the band under the jaw (0.985, 0.967), which the reference lights indirectly
+    // (tests/fixtures/truth/README.md).
+    {"studio", "front", 1.57, {1.023, 1.022, 0.999, 1.009, 1.010}, 1.139},
+    {"studio", "threequarter", 1.72, {1.000, 1.031, 0.951, 1.011, 0.999}, 0.988},
+    {"daylight", "front", 1.22, {0.985, 1.001, 0.993, 0.998, 1.015}, 0.995},
+    {"daylight", "threequarter", 1.39, {0.949, 0.991, 0.935, 0.979, 0.993}, 1.008},
+    {"office", "front", 1.55, {1.014, 1.032, 1.012, 0.994, 1.022}, 1.054},
+    {"office", "threequarter", 1.53, {1.009, 1.042, 0.996, 0.988, 1.016}, 1.057},
+    {"sunset", "front", 1.18, {1.048, 1.061, 1.018, 1.026, 1.085}, 1.014},
+    {"sunset", "threequarter", 1.37, {1.040, 1.050, 0.961, 1.009, 1.061}, 1.012},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
