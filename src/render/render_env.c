@@ -228,10 +228,11 @@ static bool lamp_free_levels(const rs_env *env, const rs_render_env *e, const fl
         const rs_env_level *lv = &env->levels[k];
         out[k] = buf;
         buf += (size_t)lv->width * lv->height;
-        double norm[RS_ENV_LAMPS] = {0};
+        double norm[RS_ENV_LAMPS] = {0}, m[RS_ENV_LAMPS] = {0};
         for (int i = 0; k > 0 && i < RS_ENV_LAMPS; i++) {
-            double wid = 0.5 * e->lamp_angle[i], m = sqrt((double)env->level_m[k] * env->level_m[k] + wid * wid);
-            norm[i] = LUM(e->lamp_color[i]) > 0 ? PI / prefilter_integral(m) : 0.0;  // power = pi x colour
+            double wid = 0.5 * e->lamp_angle[i];
+            m[i] = sqrt((double)env->level_m[k] * env->level_m[k] + wid * wid);
+            norm[i] = LUM(e->lamp_color[i]) > 0 ? PI / prefilter_integral(m[i]) : 0.0;  // power = pi x colour
         }
         for (int j = 0; j < lv->height; j++)
             for (int t = 0; t < lv->width; t++) {
@@ -246,8 +247,7 @@ static bool lamp_free_levels(const rs_env *env, const rs_render_env *e, const fl
                     for (int i = 0; i < RS_ENV_LAMPS; i++) {
                         if (norm[i] <= 0) continue;
                         const float *d = e->lamp_dir[i];
-                        double wid = 0.5 * e->lamp_angle[i], m = sqrt((double)env->level_m[k] * env->level_m[k] + wid * wid);
-                        double f = norm[i] * prefilter_lobe(R[0] * d[0] + R[1] * d[1] + R[2] * d[2], m);
+                        double f = norm[i] * prefilter_lobe(R[0] * d[0] + R[1] * d[1] + R[2] * d[2], m[i]);
                         for (int q = 0; q < 3; q++) c[q] = (float)RS_MAX(c[q] - f * e->lamp_color[i][q], 0.0);
                     }
                 }
