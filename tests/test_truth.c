@@ -9,7 +9,9 @@
 //   - path tracer / rouge mean scene-linear luminance under the chin, on the lips, ears, nose, eye sockets
 //     (the fixture's label plane: .rsf regions of the nearest splat, ears and under-chin by geometry);
 //   - rouge / path tracer mean luminance of the contour band (3 px inside the silhouette and on the near side
-//     of depth steps over 10 mm: where rouge drew dark outlines), over pixels both cover fully.
+//     of depth steps over 10 mm: where rouge drew dark outlines), over pixels both cover fully;
+//   - glare: the share of the face where rouge is brighter than the path tracer by dE > 10 (a sheen or
+//     highlight the reference does not show), held to what it was.
 // Issue 22's goals: mean dE <= 2.0, every ratio within [0.87, 1.15], the band no darker (>= 1). Where a goal
 // is not met the test guards the number measured when the fixtures were made (the `was` table) against
 // regressions and reports the goal as a skip. Also checked: the silhouettes agree (IoU) and rouge's albedo
@@ -47,7 +49,7 @@ static const char *region_names[R_COUNT] = {"under chin", "lips", "ears", "nose"
 // What rouge measured last (the regression guards; updated when a change improves them).
 typedef struct measured {
     const char *env, *view;
-    double delta_e, ratio[R_COUNT], band;
+    double delta_e, ratio[R_COUNT], band, glare;
 } measured;
 static const measured was[] = {
     // Measured with Burley's diffuse retro-reflection under environments and blocked reflections showing
@@ -58,15 +60,16 @@ static const measured was[] = {
     // (env_light.glsl, render_env.c): studio front's wet temple sheen, the map's blur of the back lamp
     // below the temple's horizon, is gone (dE 1.57 -> 1.40); studio 3/4's ears ~3 % brighter (0.951 ->
     // 0.925), its dE 1.72 -> 1.77. Daylight front and studio 3/4 stay under 1 by the band under the jaw
-    // (0.985, 0.983), which the reference lights indirectly (tests/fixtures/truth/README.md).
-    {"studio", "front", 1.40, {1.022, 1.021, 0.951, 1.011, 1.010}, 1.125},
-    {"studio", "threequarter", 1.77, {1.004, 1.035, 0.925, 1.014, 1.001}, 0.994},
-    {"daylight", "front", 1.22, {0.985, 1.000, 0.993, 0.997, 1.015}, 0.995},
-    {"daylight", "threequarter", 1.39, {0.950, 0.991, 0.935, 0.979, 0.994}, 1.008},
-    {"office", "front", 1.50, {1.014, 1.031, 1.016, 0.988, 1.022}, 1.055},
-    {"office", "threequarter", 1.53, {1.009, 1.042, 0.996, 0.989, 1.016}, 1.055},
-    {"sunset", "front", 1.18, {1.048, 1.061, 1.018, 1.026, 1.085}, 1.013},
-    {"sunset", "threequarter", 1.37, {1.041, 1.050, 0.961, 1.009, 1.061}, 1.012},
+    // (0.985, 0.983), which the reference lights indirectly (tests/fixtures/truth/README.md). Glare: the
+    // temple's sheen made 1.13 % of studio front's face brighter than the reference by dE > 10; 0.41 now.
+    {"studio", "front", 1.40, {1.022, 1.021, 0.951, 1.011, 1.010}, 1.125, 0.41},
+    {"studio", "threequarter", 1.77, {1.004, 1.035, 0.925, 1.014, 1.001}, 0.994, 0.37},
+    {"daylight", "front", 1.22, {0.985, 1.000, 0.993, 0.997, 1.015}, 0.995, 0.14},
+    {"daylight", "threequarter", 1.39, {0.950, 0.991, 0.935, 0.979, 0.994}, 1.008, 0.05},
+    {"office", "front", 1.50, {1.014, 1.031, 1.016, 0.988, 1.022}, 1.055, 0.07},
+    {"office", "threequarter", 1.53, {1.009, 1.042, 0.996, 0.989, 1.016}, 1.055, 0.01},
+    {"sunset", "front", 1.18, {1.048, 1.061, 1.018, 1.026, 1.085}, 1.013, 0.00},
+    {"sunset", "threequarter", 1.37, {1.041, 1.050, 0.961, 1.009, 1.061}, 1.012, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
@@ -241,6 +244,7 @@ typedef struct result {
     double k, iou, albedo_diff, delta_e, ratio[R_COUNT], band;
     double band_low, band_high;  // the band below the lips' lowest row (under the jaw) and above it
     double forehead, highlights;  // path tracer / rouge: specular-dominated areas (diagnostics, not goals)
+    double glare;                 // % of face pixels where rouge is brighter by dE > 10 (a sheen the reference lacks)
     int region_px[R_COUNT], band_px, band_low_px;
 } result;
 
@@ -339,6 +343,10 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     }
     free(rblur), free(pblur);
     res->delta_e = de_sum / (double)de_n;
+    size_t glare = 0;
+    for (size_t i = 0; i < n; i++)
+        if (mask[i] && de[i] > 10.0 && lum(ro + i * 3) > lum(pt + i * 3)) glare++;
+    res->glare = 100.0 * (double)glare / (double)de_n;
     // Region and contour luminance. The band compares surfaces, both fully covered: the path tracer's pixel
     // at coverage 255 (its radiance unpremultiplied), rouge's not one of its anti-aliased silhouette pixels
     // (a face pixel with background in its 3x3, drawn at 1/2 to 7/8 over the black background,
@@ -452,8 +460,8 @@ static void test_view(void)
     for (int i = 0; i < R_COUNT; i++)
         if (r.region_px[i] >= 20) printf(" %s %.3f", region_names[i], r.ratio[i]);
     printf("; contour band rouge / path tracer %.3f (%d px: under the jaw %.3f, %d px; above it %.3f); specular"
-           " areas, path tracer / rouge: forehead %.3f highlights %.3f\n", r.band, r.band_px, r.band_low,
-           r.band_low_px, r.band_high, r.forehead, r.highlights);
+           " areas, path tracer / rouge: forehead %.3f highlights %.3f; glare %.2f %% of the face\n", r.band,
+           r.band_px, r.band_low, r.band_low_px, r.band_high, r.forehead, r.highlights, r.glare);
     // The fixture is the scene rouge renders: same camera and outline, same albedo.
     RS_CHECK(r.iou >= 0.98, "silhouettes differ: IoU %.4f", r.iou);
     // albedo_diff -1: not checked under this environment.
@@ -477,6 +485,9 @@ static void test_view(void)
     }
     if (r.band < GOAL_BAND) len += snprintf(unmet + len, sizeof unmet - len, " contour band %.3f (goal >= 1)", r.band);
     held &= RS_CHECK(r.band >= fmin(GOAL_BAND, ref->band - 0.03), "contour band %.3f (was %.3f)", r.band, ref->band);
+    // A sheen or highlight the reference does not show (the temple's, before the lamps were reflected
+    // exactly): more of the face brighter than the path tracer by dE > 10.
+    held &= RS_CHECK(r.glare <= ref->glare + 0.3, "glare %.2f %% of the face (was %.2f %%)", r.glare, ref->glare);
     if (!goal && held) rs_test_skip("issue 22's goal not met yet (%s %s):%s", ref->env, ref->view, unmet);
 }
 
