@@ -157,6 +157,7 @@ vec3 rs_env_lamp_specular(vec3 N_view, vec3 V_view, float m, float f0, vec3 vis,
 {
     vec3 N = u_env_from_view * N_view, V = u_env_from_view * V_view, s = vec3(0.0);
     for (int i = 0; i < 3; i++) {
+        if (dot(u_env_lamp_color[i], u_env_lamp_color[i]) <= 0.0) continue;  // unused
         vec3 L = u_env_lamp_dir[i];
         float w = u_env_lamp_widen[i], e = dot(N, L);  // e: ~ the lamp's centre's elevation
         float r = sqrt(4.0 * w * w + spread * spread);  // its radius (2 w), and the normals' sweep
