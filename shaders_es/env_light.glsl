@@ -170,7 +170,7 @@ vec3 rs_env_lamp_specular(vec3 N_view, vec3 V_view, float m, float f0, vec3 vis,
             fw += wt;
             if (dot(N, Ls) > 0.0) f += wt * rs_ksk_lobe(N, Ls, V, mw, f0);
         }
-        float v = min(vis[i] + (1.0 - smoothstep(0.0, 0.08, e)), 1.0);  // rs_lamp_shadow's attached term undone
+        float v = min(vis[i] + (1.0 - rs_attached(e)), 1.0);  // rs_lamp_shadow's attached shadow undone
         s += u_env_lamp_color[i] * (f / fw * v);
     }
     return s;

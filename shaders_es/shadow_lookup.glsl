@@ -42,6 +42,14 @@ void rs_shadow_plane(vec3 p, vec3 n, mat4 m, mat3 nm, vec3 dir, float base, floa
     bias = base * (1.0 + slope) + texel * min(glen, 4.0);
 }
 
+// A surface facing away from a light is in its own (attached) shadow whatever a map says, faded in over the
+// last few degrees (n.l: the cosine to the light), where N.L is near zero anyway, so the blended normals'
+// noise leaves no jagged edge.
+float rs_attached(float ndotl)
+{
+    return smoothstep(0.0, 0.08, ndotl);
+}
+
 float rs_shadow(vec3 p, vec3 n)
 {
     if (u_shadow_on < 0.5) return 1.0;
@@ -50,10 +58,9 @@ float rs_shadow(vec3 p, vec3 n)
     // receiver's own plane gives each PCF tap its depth (receiver-plane depth bias): a tilted receiver
     // does not shadow itself, and the constant bias left (the disks' departure from the surface, a
     // texel's quantisation) moves only contact shadows, by bias x tan(theta).
-    // Facing away from the light: in its own (attached) shadow, whatever the map says (the receiver plane
-    // below would tilt the comparison the wrong way); faded in over the last few degrees, where N.L is
-    // near zero anyway, so the blended normals' noise leaves no jagged edge.
-    float attached = smoothstep(0.0, 0.08, dot(n, u_shadow_dir));
+    // Facing away from the light: attached shadow (the receiver plane below would tilt the comparison the
+    // wrong way).
+    float attached = rs_attached(dot(n, u_shadow_dir));
     if (attached <= 0.0) return 0.0;
     vec3 s;
     vec2 grad;
@@ -79,7 +86,7 @@ float rs_shadow(vec3 p, vec3 n)
 float rs_lamp_shadow(int k, vec3 p, vec3 n)
 {
     if (u_lamp_shadow_on[k] < 0.5) return 1.0;
-    float attached = smoothstep(0.0, 0.08, dot(n, u_lamp_shadow_dir[k]));
+    float attached = rs_attached(dot(n, u_lamp_shadow_dir[k]));
     if (attached <= 0.0) return 0.0;
     vec3 s;
     vec2 grad;

@@ -265,11 +265,11 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     int w = t->w, h = t->h;
     size_t n = (size_t)w * h;
     uint8_t *img = malloc(n * 4), *alb = malloc(n * 4), *mask = calloc(n, 1), *face_px = calloc(n, 1);
-    uint8_t *edge_px = calloc(n, 1);
+    uint8_t *edge_px = calloc(n, 1), *in_band = calloc(n, 1);
     double *ro = malloc(n * 3 * sizeof(double)), *pt = malloc(n * 3 * sizeof(double));
     double *rb = malloc(n * 3 * sizeof(double)), *pb = malloc(n * 3 * sizeof(double));
     double *ratio = malloc(n * sizeof(double)), *de = calloc(n, sizeof(double));
-    bool ok = RS_CHECK(img && alb && mask && face_px && edge_px && ro && pt && rb && pb && ratio && de, "out of memory");
+    bool ok = RS_CHECK(img && alb && mask && face_px && edge_px && in_band && ro && pt && rb && pb && ratio && de, "out of memory");
     rouge_view v = {.width = w, .height = h, .yaw_deg = t->yaw, .pitch_deg = t->pitch, .env = env,
                     .pipeline = ROUGE_PIPELINE_REFERENCE, .background = {0, 0, 0, 1}};
     ok = ok && render(&v, img);
@@ -367,11 +367,6 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     size_t jaw_row = n;  // first pixel index below the lips' lowest row (n: no lips in view)
     for (size_t i = 0; i < n; i++)
         if (region_of(t->label[i]) == R_LIPS) jaw_row = (i / (size_t)w + 1) * (size_t)w;
-    uint8_t *in_band = calloc(n, 1);
-    if (!RS_CHECK(in_band, "out of memory")) {
-        ok = false;
-        goto out;
-    }
     for (size_t i = 0; i < n; i++) {
         int r = region_of(t->label[i]);
         if (r >= 0 && mask[i]) {
@@ -436,9 +431,8 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
         rs_test_save(png_name, &side);
         rs_image_free(&side);
     }
-    free(in_band);
 out:
-    free(img), free(alb), free(mask), free(face_px), free(edge_px), free(ro), free(pt), free(rb), free(pb), free(ratio), free(de);
+    free(img), free(alb), free(mask), free(face_px), free(edge_px), free(in_band), free(ro), free(pt), free(rb), free(pb), free(ratio), free(de);
     return ok;
 }
 

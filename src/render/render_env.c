@@ -105,8 +105,8 @@ static int cmp_float(const void *a, const void *b)
 // than 5 % of the map's mean irradiance is not worth it and ends the search. Each one's SH projection
 // (a directional light of colour c: sh_k = pi a_l c Y_k(d), a_l = 1, 2/3, 1/4) leaves the SH, and the
 // shader adds it exactly, shadow-mapped (env_light.glsl, render_shadow.c). The specular reflects them
-// exactly too (env_light.glsl rs_env_lamp_specular): rgb, level 0 of the map decoded, comes back without
-// them (each region's texels down to its surround), and lamp_free_levels takes them out of the coarser
+// exactly too (env_light.glsl rs_env_lamp_specular): rgb (3 floats a texel of level 0) gets level 0
+// decoded and without them (each region's texels down to its surround), and lamp_free_levels takes them out of the coarser
 // levels. False when out of memory.
 static bool find_lamps(const rs_env *env, rs_render_env *e, float *rgb)
 {
@@ -316,7 +316,6 @@ rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
     uint32_t *level[RS_ENV_MAX_LEVELS] = {NULL};
     bool ok = rgb0 != NULL;
     memcpy(e->sh, env->sh, sizeof e->sh);  // find_lamps takes the lamps out of it
-    for (size_t t = 0; ok && t < (size_t)w * h; t++) rs_rgb9e5_unpack(env->levels[0].rgb9e5[t], rgb0 + 3 * t);
     ok = ok && find_lamps(env, e, rgb0) && lamp_free_levels(env, e, rgb0, level);
     free(rgb0);
     if (!ok) {
