@@ -76,9 +76,11 @@
 
 // sRGB8 <-> linear tables: a stamp composes thousands of splats, and powf per channel would be most
 // of its cost. Built once per layer (and per call of the public rs_makeup_compose).
+#define SEED_BINS 4096  // to_srgb8's first guess: one bin spans at most 0.8 codes (the curve's steepest part)
 typedef struct colour_tables {
-    float to_lin[256];  // linear value of sRGB8 q
-    float mid[255];     // linear value at sRGB (q + 0.5) / 255: rounding thresholds back to sRGB8
+    float to_lin[256];            // linear value of sRGB8 q
+    float mid[255];               // linear value at sRGB (q + 0.5) / 255: rounding thresholds back to sRGB8
+    uint8_t seed[SEED_BINS + 1];  // code of the linear value k / SEED_BINS: where to_srgb8 starts
 } colour_tables;
 
 typedef struct grid_cell {
@@ -290,17 +292,22 @@ static void build_tables(colour_tables *t)
 {
     for (int q = 0; q < 256; q++) t->to_lin[q] = rs_srgb_to_linear(q / 255.0f);
     for (int q = 0; q < 255; q++) t->mid[q] = rs_srgb_to_linear((q + 0.5f) / 255.0f);
+    uint32_t q = 0;
+    for (int k = 0; k <= SEED_BINS; k++) {
+        float x = (float)k / SEED_BINS;
+        while (q < 255 && x >= t->mid[q]) q++;
+        t->seed[k] = (uint8_t)q;
+    }
 }
 
-// Nearest sRGB8 code of a linear value (round in the sRGB domain): binary search of the thresholds.
+// Nearest sRGB8 code of a linear value (round in the sRGB domain): the thresholds at or below x, counted
+// from the seed of x's bin (a step or none; a binary search's eight unpredictable branches were a third
+// of a stamp's time, and more of it in WebAssembly).
 static uint8_t to_srgb8(const colour_tables *t, float x)
 {
-    uint32_t lo = 0, hi = 255;
-    while (lo < hi) {
-        uint32_t m = (lo + hi) / 2;
-        if (x >= t->mid[m]) lo = m + 1;
-        else hi = m;
-    }
+    if (!(x > 0.0f)) return 0;  // NaN too
+    uint32_t lo = t->seed[x < 1.0f ? (int)(x * SEED_BINS) : SEED_BINS];
+    while (lo < 255 && x >= t->mid[lo]) lo++;
     return (uint8_t)lo;
 }
 
