@@ -295,7 +295,7 @@ float normal_spread(ivec2 px, vec3 N)
         vec4 a = texelFetch(u_attr0, q, 0);
         if (a.a <= u_min_weight) continue;
         vec3 nq = normalize(texelFetch(u_attr1, q, 0).xyz / a.a * 2.0 - 1.0);
-        d = max(d, acos(clamp(dot(N, nq), -1.0, 1.0)));
+        d = max(d, rs_acos(clamp(dot(N, nq), -1.0, 1.0)));
     }
     return d;
 }
