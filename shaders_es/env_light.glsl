@@ -105,9 +105,11 @@ float rs_env_lobe_albedo(float ndotv, float m, float f0)
 // much wider than their own spread (3 x 3 taps of 0.6 of the lobe: office, studio +-25 % on a sphere), so
 // the taps' own spread is 0.75 of the lobe's across it: 3 taps across are then no wider apart than that, and
 // along the plane 5 still resolve the horizon at grazing (test_env_specular: every band within 12 %; 5 x 5
-// gave 8 % at two thirds of the cost). Where the surface faces the eye (N.V >= 0.8, most of a face in
+// gave 8 % at two thirds of the cost). Where the surface faces the eye (N.V >= 0.6, most of a face in
 // view) one lookup does (below): the grid's 15 taps there were two thirds of the environment's cost on
-// llvmpipe and bought under 4 % in any band.
+// llvmpipe and half of it on an H100 (the warps that hold one grid pixel run 15 taps), and bought under
+// 3 % in any band of the sphere (from 0.8: the same bands within 1.5 %, the face's dE against the path
+// tracer the same or lower).
 vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
 {
     // All in the environment's frame (a rotation of view space: the lobe's dot products are kept).
@@ -123,10 +125,10 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     float sigma = 1.4142 * max(m, 0.02);      // the lobe's spread along the plane, radians
     float across = clamp(ndotv, 0.0, 1.0);    // across it, relative
     // Facing the eye the lobe is nearly round and far above the horizon, and one lookup of its whole
-    // spread (along and across averaged) does; from N.V 0.65 to 0.8 the grid's spread eases into that one
+    // spread (along and across averaged) does; from N.V 0.45 to 0.6 the grid's spread eases into that one
     // lookup's, so its taps close in on R and no seam shows where their number drops.
-    float s1 = sqrt(0.5 + 0.5 * across * across), e = smoothstep(0.65, 0.8, across);
-    bool one = across >= 0.8;
+    float s1 = sqrt(0.5 + 0.5 * across * across), e = smoothstep(0.45, 0.6, across);
+    bool one = across >= 0.6;
     int na = one ? 0 : 2, nc = one ? 0 : 1;
     float va = mix(1.0, s1 * s1, e), vc = mix(across * across, s1 * s1, e);  // the variances the grid stands
     float s = mix(max(0.75 * across, 0.2), s1, e);                           // for, relative to sigma^2
@@ -134,13 +136,15 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     float d2 = min(sigma * sqrt(2.0 * max(vc - s * s, 0.0)), 0.6);
     float g1 = d1 * d1 / (2.0 * sigma * sigma * va), g2 = d2 * d2 / (2.0 * sigma * sigma * max(vc, 1e-4));
     float lod = rs_env_lod(s * m);
+    // One lookup: the tap at R, whose weight is the lobe over itself (1).
+    if (one) return rs_env_radiance(R, lod) * rs_env_lobe_albedo(ndotv, m, f0);
     float fc = max(rs_ksk_lobe(N, R, V, m, f0), 1e-20);
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
     // Offsets and weights from the loop counters alone: a small local array indexed by them cost the H100
     // an eighth of the environment's time (it went to local memory). The bounds vary per pixel, so no
     // compiler unrolls the loops (constant 5 x 3 bounds, unrolled by Mesa at this function's three call
-    // sites, tripled llvmpipe's compile of the composite), and a block of pixels facing the eye runs once.
+    // sites, tripled llvmpipe's compile of the composite).
     float b = tan(d2);  // tan(j d2) = j tan(d2) for j in -1..1
     for (int i = -na; i <= na; i++) {
         float a = tan(float(i) * d1);

@@ -62,14 +62,15 @@ static const measured was[] = {
     // 0.925), its dE 1.72 -> 1.77. Daylight front and studio 3/4 stay under 1 by the band under the jaw
     // (0.985, 0.983), which the reference lights indirectly (tests/fixtures/truth/README.md). Glare: the
     // temple's sheen made 1.13 % of studio front's face brighter than the reference by dE > 10; 0.41 now.
-    {"studio", "front", 1.40, {1.022, 1.021, 0.951, 1.011, 1.010}, 1.125, 0.41},
-    {"studio", "threequarter", 1.77, {1.004, 1.035, 0.925, 1.014, 1.001}, 0.994, 0.37},
-    {"daylight", "front", 1.22, {0.985, 1.000, 0.993, 0.997, 1.015}, 0.995, 0.14},
-    {"daylight", "threequarter", 1.39, {0.950, 0.991, 0.935, 0.979, 0.994}, 1.008, 0.05},
-    {"office", "front", 1.50, {1.014, 1.031, 1.016, 0.988, 1.022}, 1.055, 0.07},
-    {"office", "threequarter", 1.53, {1.009, 1.042, 0.996, 0.989, 1.016}, 1.055, 0.01},
-    {"sunset", "front", 1.18, {1.048, 1.061, 1.018, 1.026, 1.085}, 1.013, 0.00},
-    {"sunset", "threequarter", 1.37, {1.041, 1.050, 0.961, 1.009, 1.061}, 1.012, 0.00},
+    // The environment's specular as one lookup from N.V 0.6 (was 0.8): office 1.50 / 1.53 -> 1.47 / 1.46.
+    {"studio", "front", 1.40, {1.021, 1.020, 0.951, 1.011, 1.010}, 1.127, 0.41},
+    {"studio", "threequarter", 1.76, {1.003, 1.034, 0.926, 1.013, 1.001}, 0.994, 0.37},
+    {"daylight", "front", 1.22, {0.985, 1.000, 0.991, 0.997, 1.016}, 0.995, 0.14},
+    {"daylight", "threequarter", 1.38, {0.951, 0.992, 0.935, 0.980, 0.994}, 1.006, 0.05},
+    {"office", "front", 1.47, {1.016, 1.031, 1.018, 0.988, 1.023}, 1.056, 0.07},
+    {"office", "threequarter", 1.46, {1.007, 1.041, 0.997, 0.987, 1.014}, 1.056, 0.01},
+    {"sunset", "front", 1.18, {1.047, 1.061, 1.017, 1.026, 1.084}, 1.013, 0.00},
+    {"sunset", "threequarter", 1.35, {1.042, 1.050, 0.960, 1.009, 1.062}, 1.012, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
