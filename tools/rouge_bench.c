@@ -616,7 +616,7 @@ static void frame_rows(bench *b, rs_gl_context *gl)
             const rs_render_stats *st = &fr[c].stats;
             snprintf(notes, sizeof notes, "%s; %u splats drawn, %d diffusion levels (%u diffusion splats), %s; "
                      "median of %d", what_runs, st->splats_drawn, st->kernel_count, st->diffusion_splats,
-                     st->used_points ? "point sprites (stage 3: the disks' quads)" : "quads", b->frames);
+                     st->used_points ? "point sprites" : "quads", b->frames);
             add_row(b, what, notes, "%.1f ms", fr[c].ms);
         }
         char what[96];

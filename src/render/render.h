@@ -139,7 +139,7 @@ typedef struct rs_render_stats {
     uint32_t splats_drawn;           // main passes
     uint32_t diffusion_splats;       // summed over diffusion levels
     int kernel_count;
-    bool used_points;                // sprites as points (true) or instanced quads (false); stage 3 draws the disks' own quads
+    bool used_points;                // point sprites (true) or instanced quads (false)
     bool float_targets;
     size_t gpu_bytes;                // buffers + textures owned by the renderer
     double stage_ms[RS_STAGE_COUNT]; // last frame, glFinish-timed (desc.time_stages); 0 otherwise
