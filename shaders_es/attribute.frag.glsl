@@ -1,8 +1,7 @@
 #version 300 es
-// attribute.frag.glsl — stage 3: the Gaussian weight w at the pixel's point of the disk (the disk's own
-// quad: attribute.vert.glsl), and w-weighted attributes added (GL_ONE, GL_ONE) into three targets; the
-// composite divides by the summed weight. Depth-tested (LEQUAL, no writes, before this shader runs)
-// against the visibility pass, so only the front surface layer accumulates.
+// attribute.frag.glsl — stage 3: the ray-disk hit's Gaussian weight w, and w-weighted attributes added
+// (GL_ONE, GL_ONE) into three targets; the composite divides by the summed weight. Depth-tested (LEQUAL,
+// no writes) against the visibility pass, so only the front surface layer accumulates.
 //   RT0 = (albedo, 1) w      RT1 = (normal * 0.5 + 0.5, m) w
 //   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w, or (rho_s, debug colour) w in the debug views
 // Normals are stored offset to 0..1 so the RGBA8 fallback needs no signed format; u_weight_scale keeps the
@@ -10,6 +9,7 @@
 // rounding to nothing where it alone covers a pixel (next to occluding edges).
 precision highp float;
 precision highp int;
+#include "splat_ray.glsl"
 
 uniform float u_coverage;  // disks are drawn out to this many radii (render_kit.h RS_COVERAGE)
 
@@ -17,13 +17,14 @@ uniform float u_inv_two_sigma2;   // 1 / (2 sigma^2), sigma in disk radii
 uniform float u_weight_scale;
 uniform float u_weight_floor;     // RGBA8 fallback: rims count enough to survive 8-bit rounding
 
+flat in vec3 v_c;
 flat in vec3 v_n;
+flat in float v_r;
 flat in vec3 v_albedo;
 flat in vec2 v_spec;
 flat in vec3 v_debug;
 flat in vec3 v_layers;
 uniform int u_debug;
-in vec2 v_disk;
 
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;
@@ -31,9 +32,11 @@ layout(location = 2) out vec4 o_extra;
 
 void main()
 {
-    float l2 = dot(v_disk, v_disk);
-    if (l2 > 1.0) discard;
-    float l = sqrt(l2) * u_coverage;  // in disk radii
+    vec3 o, d, q;
+    float l;
+    rs_pixel_ray(gl_FragCoord.xy, o, d);
+    if (!rs_ray_disk(o, d, v_c, v_n, v_r, u_coverage, q, l)) discard;
+    gl_FragDepth = rs_depth_of(q);
     float w = max(exp(-l * l * u_inv_two_sigma2), u_weight_floor) * u_weight_scale;
     o_albedo = vec4(v_albedo, 1.0) * w;
     o_normal = vec4(v_n * 0.5 + 0.5, v_spec.x) * w;

@@ -2,10 +2,7 @@
 // attribute.vert.glsl — stage 3, attribute splatting: per splat, what the fragment shader blends: linear
 // albedo (with the makeup layer composed over it), view-space normal, the specular parameters m and rho_s
 // from the region table (and makeup), the finish layers (clear coat, flakes) and the splat's ambient
-// occlusion, and a debug colour (region or LOD level). Always drawn as the disks' own quads (RS_QUADS,
-// rs_disk_quad): the rasteriser gives each pixel the disk's exact depth, so the depth test against stage 2
-// runs before the fragment shader (ray-disk sprites wrote gl_FragDepth, which defers it: every splat of
-// every layer was shaded, then discarded; on an H100 the pass took 3.3 ms, 2.4 as quads).
+// occlusion, and a debug colour (region or LOD level).
 precision highp float;
 precision highp int;
 #include "splat_decode.glsl"
@@ -27,12 +24,13 @@ uniform int u_debug;
 uniform uint u_lods[24];                  // LOD table, descending
 uniform int u_lod_count;
 
+flat out vec3 v_c;
 flat out vec3 v_n;
+flat out float v_r;
 flat out vec3 v_albedo;
 flat out vec2 v_spec;    // m, rho_s
 flat out vec3 v_layers;  // ambient occlusion, clear-coat weight, flake weight
 flat out vec3 v_debug;
-out vec2 v_disk;         // the fragment's position in the disk, in u_coverage radii from its centre
 
 // The coarsest LOD level whose prefix holds splat i (the table descends: lods[0] = all splats).
 int lod_level(uint i)
@@ -58,11 +56,13 @@ void main()
     float rho_s = u_region_rho[region];
     float coat = 0.0, shimmer = 0.0;
     if (u_makeup_on > 0.5) rs_makeup_apply(a_makeup, albedo, m, rho_s, coat, shimmer);
+    v_c = c;
     v_n = n;
+    v_r = s.radius * u_radius_scale;
     v_albedo = albedo;
     v_spec = vec2(m, rho_s);
     v_layers = vec3(s.ao, coat, shimmer);
     v_debug = u_debug == 1 ? u_debug_color[region]
             : u_debug == 2 ? u_debug_color[lod_level(rs_splat_index())] : vec3(0.0);
-    v_disk = rs_disk_quad(c, n, s.radius * u_radius_scale * u_coverage);
+    rs_sprite(c, v_r * u_coverage);
 }

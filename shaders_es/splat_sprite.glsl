@@ -1,7 +1,6 @@
 // splat_sprite.glsl — vertex side of every splat pass: a screen-aligned sprite (a point sprite, or with
 // RS_QUADS one instance of a 4-vertex strip) covering a view-space sphere, so the fragment shader can
-// intersect the exact disk (or evaluate the kernel) inside it; or (rs_disk_quad, RS_QUADS) the square
-// around the disk in the disk's own plane.
+// intersect the exact disk (or evaluate the kernel) inside it.
 uniform mat4 u_proj;
 uniform vec2 u_viewport;     // target size, pixels
 uniform float u_point_max;   // GL_ALIASED_POINT_SIZE_RANGE max (points path)
@@ -68,20 +67,3 @@ void rs_sprite(vec3 c, float R)
 #endif
     gl_Position = clip;
 }
-
-#ifdef RS_QUADS
-// This vertex of the square around the disk (centre c, normal n, radius R) in the disk's own plane, and its
-// position in the disk in R (1.01: the inscribed disk's rim stays inside the square). The rasteriser then
-// interpolates the plane's depth, exact per pixel (perspective-correct), so the fragment shader writes no
-// gl_FragDepth and the depth test runs before it; and a splat seen obliquely covers cos(theta) of a
-// screen-aligned sprite's pixels.
-vec2 rs_disk_quad(vec3 c, vec3 n, float R)
-{
-    vec3 t1 = normalize(abs(n.x) < 0.7 ? vec3(0.0, n.z, -n.y) : vec3(n.y, -n.x, 0.0));
-    vec2 corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1)) * 2.0 - 1.0;
-    vec3 p = c + (corner.x * t1 + corner.y * cross(n, t1)) * (R * 1.01);
-    gl_Position = u_proj * vec4(p, 1.0);
-    gl_PointSize = 1.0;
-    return corner * 1.01;
-}
-#endif

@@ -41,9 +41,16 @@ void main()
     v_id = rs_splat_index() + 1u;
 #endif
 #if defined(RS_SHADOW) && defined(RS_QUADS)
-    // The shadow map (orthographic) as the disks' own quads: on llvmpipe ~7x cheaper than point sprites,
-    // the same map to float rounding. Points (RS_PRIM_POINTS) still take the ray-disk path below.
-    v_disk = rs_disk_quad(c, n, v_r * u_coverage);
+    // The shadow map (orthographic) as instanced quads: the square around the disk in the disk's own
+    // plane, so the rasteriser interpolates the plane's depth (no gl_FragDepth: early depth test) and a
+    // splat seen obliquely from the light covers cos(theta) of a screen-aligned sprite's texels: on
+    // llvmpipe ~7x cheaper than point sprites, the same map to float rounding. Points (RS_PRIM_POINTS)
+    // still take the ray-disk path below. 1.01: the inscribed disk's rim stays inside the square.
+    vec3 t1 = normalize(abs(n.x) < 0.7 ? vec3(0.0, n.z, -n.y) : vec3(n.y, -n.x, 0.0));
+    vec2 corner = vec2(float(gl_VertexID & 1), float(gl_VertexID >> 1)) * 2.0 - 1.0;
+    v_disk = corner * 1.01;
+    vec3 p = c + (corner.x * t1 + corner.y * cross(n, t1)) * (v_r * u_coverage * 1.01);
+    gl_Position = u_proj * vec4(p, 1.0);
 #else
     rs_sprite(c, v_r * u_coverage);
 #endif

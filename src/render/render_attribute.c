@@ -1,7 +1,5 @@
-// render_attribute.c — stage 3, attribute splatting (paper Fig. 2): the splats again, as the disks' own
-// quads whatever the view's primitive (the rasteriser gives the disk's exact depth: the depth test runs
-// before the fragment shader; attribute.vert.glsl), depth-tested (LEQUAL, no writes) against stage 2,
-// their Gaussian-weighted attributes added into three targets:
+// render_attribute.c — stage 3, attribute splatting (paper Fig. 2): the splats again, depth-tested (LEQUAL,
+// no writes) against stage 2, their Gaussian-weighted attributes added into three targets:
 //   RT0 = (albedo, 1) w,  RT1 = (normal * 0.5 + 0.5, m) w,
 //   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w (the debug views: (rho_s, debug colour) w).
 // w = exp(-l^2 / (2 sigma^2)) with l the hit's distance from the disk centre in radii.
@@ -46,7 +44,7 @@ static void lod_palette(int levels, float out[24][3])
 rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
 {
     GLuint prog;
-    rs_result res = rs_render_program(r, RS_PROG_ATTRIBUTE, true, &prog, err);
+    rs_result res = rs_render_program(r, RS_PROG_ATTRIBUTE, f->quads, &prog, err);
     if (res != RS_OK) return res;
     const rs_camera *cam = &f->cam;
     const rs_splat_header *h = &r->cloud->hdr;
@@ -91,7 +89,7 @@ rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform1uiv(rs_uloc(prog, "u_lods"), 24, lods);
     glUniform1i(rs_uloc(prog, "u_lod_count"), (int)RS_MIN(h->lod_count, 24u));
 
-    rs_render_draw_splats(r, f->count, true);  // the disks' own quads, whatever f->quads
+    rs_render_draw_splats(r, f->count, f->quads);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     return RS_OK;
