@@ -116,6 +116,15 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     vec3 N = u_env_from_view * N_view, V = u_env_from_view * V_view;
     float ndotv = max(dot(N, V), 1e-4);
     vec3 R = reflect(-V, N);
+    float across = clamp(ndotv, 0.0, 1.0);    // the lobe's width across the plane of incidence, relative
+    // Facing the eye the lobe is nearly round and far above the horizon, and one lookup of its whole
+    // spread (along and across averaged) does; from N.V 0.45 to 0.6 the grid's spread eases into that one
+    // lookup's, so its taps close in on R and no seam shows where their number drops.
+    float s1 = sqrt(0.5 + 0.5 * across * across), e = smoothstep(0.45, 0.6, across);
+    float s = mix(max(0.75 * across, 0.2), s1, e);  // the taps' own spread, relative to the lobe's
+    float lod = rs_env_lod(s * m);
+    // One lookup: the tap at R, whose weight is the lobe over itself (1).
+    if (across >= 0.6) return rs_env_radiance(R, lod) * rs_env_lobe_albedo(ndotv, m, f0);
     // t1: in the plane of incidence, from R towards N; t2 across it.
     vec3 t1 = N - R * dot(N, R);
     float l1 = dot(t1, t1);
@@ -123,27 +132,20 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
                                                             : normalize(cross(R, vec3(1.0, 0.0, 0.0))));
     vec3 t2 = cross(R, t1);
     float sigma = 1.4142 * max(m, 0.02);      // the lobe's spread along the plane, radians
-    float across = clamp(ndotv, 0.0, 1.0);    // across it, relative
-    // Facing the eye the lobe is nearly round and far above the horizon, and one lookup of its whole
-    // spread (along and across averaged) does; from N.V 0.45 to 0.6 the grid's spread eases into that one
-    // lookup's, so its taps close in on R and no seam shows where their number drops.
-    float s1 = sqrt(0.5 + 0.5 * across * across), e = smoothstep(0.45, 0.6, across);
-    bool one = across >= 0.6;
-    int na = one ? 0 : 2, nc = one ? 0 : 1;
-    float va = mix(1.0, s1 * s1, e), vc = mix(across * across, s1 * s1, e);  // the variances the grid stands
-    float s = mix(max(0.75 * across, 0.2), s1, e);                           // for, relative to sigma^2
+    // The variances the grid stands for, relative to sigma^2, and the taps' spacing along and across.
+    float va = mix(1.0, s1 * s1, e), vc = mix(across * across, s1 * s1, e);
     float d1 = min(sigma * sqrt(max(va - s * s, 0.0)), 0.6);
     float d2 = min(sigma * sqrt(2.0 * max(vc - s * s, 0.0)), 0.6);
     float g1 = d1 * d1 / (2.0 * sigma * sigma * va), g2 = d2 * d2 / (2.0 * sigma * sigma * max(vc, 1e-4));
-    float lod = rs_env_lod(s * m);
-    // One lookup: the tap at R, whose weight is the lobe over itself (1).
-    if (one) return rs_env_radiance(R, lod) * rs_env_lobe_albedo(ndotv, m, f0);
+    // Taps at a spacing of 0 fall on the centre's direction and leave the weighted mean as it is: a row or
+    // column of them is skipped (at grazing, N.V <= 0.2, the grid has no width across).
+    int na = d1 > 0.0 ? 2 : 0, nc = d2 > 0.0 ? 1 : 0;
     float fc = max(rs_ksk_lobe(N, R, V, m, f0), 1e-20);
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
     // Offsets and weights from the loop counters alone: a small local array indexed by them cost the H100
-    // an eighth of the environment's time (it went to local memory). The bounds vary per pixel, so no
-    // compiler unrolls the loops (constant 5 x 3 bounds, unrolled by Mesa at this function's three call
+    // an eighth of the environment's time (it went to local memory). The bounds vary per pixel (na, nc), so
+    // no compiler unrolls the loops (constant 5 x 3 bounds, unrolled by Mesa at this function's three call
     // sites, tripled llvmpipe's compile of the composite).
     float b = tan(d2);  // tan(j d2) = j tan(d2) for j in -1..1
     for (int i = -na; i <= na; i++) {
