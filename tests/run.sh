@@ -92,7 +92,6 @@ p=$(cat "$logs"/*.log | grep -c '^ok - ')
 f=$(cat "$logs"/*.log | grep -c '^FAIL - ')
 s=$(cat "$logs"/*.log | grep -c '^skip - ')
 [ "$f" -gt 0 ] && status=1
-echo "$p passed, $f failed, $s skipped"
 # What the time went to: the CPU seconds of all tests (what the cores must share) and the slowest ones.
 sed -n 's/^# \(.*\): \([0-9.]*\) s wall, \([0-9.]*\) s CPU$/\3 \2 \1/p' "$logs"/*.log | sort -n -r | awk '
     { cpu += $1; if (NR <= 8) top = top sprintf("#   %6.1f s CPU %6.1f s wall  %s\n", $1, $2, $3) }
@@ -101,4 +100,5 @@ sed -n 's/^# \(.*\): \([0-9.]*\) s wall, \([0-9.]*\) s CPU$/\3 \2 \1/p' "$logs"/
 native_end=$(for e in "$logs"/*.end; do case "$e" in *tests_test_web.sh.end) ;; *) cat "$e" ;; esac; done | sort -n | tail -1)
 [ -n "$native_end" ] && awk -v s="$run_start" -v e="$native_end" \
     'BEGIN { printf "# native tests (all but tests/test_web.sh): %.1f s wall\n", e - s }'
+echo "$p passed, $f failed, $s skipped"  # the last line, for whatever reads the result
 exit $status
