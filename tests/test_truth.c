@@ -19,7 +19,9 @@
 // rouge | path tracer | dE map | band map PNGs go to the test output folder (truth_ENV_VIEW.png); the band
 // map shows rouge / path tracer per band pixel over rouge's grey luminance: blue where rouge is darker,
 // red where brighter, full colour at 25 %. The band is also split at the lips' lowest row: under the jaw
-// (the jaw's and chin's underside and the neck's edges) and above it (scalp, ears, face outline, nose).
+// (the jaw's and chin's underside and the neck's edges) and above it (scalp, ears, face outline, nose), and
+// into the outline (within 4 px of the reference's) and the depth steps inside the face; the band's +-
+// is the reference's sampling noise on it (one standard error).
 #include "support/harness.h"
 #include "gl/gl.h"
 #include "rouge.h"
@@ -244,6 +246,8 @@ static void heat(double de, uint8_t *p)
 typedef struct result {
     double k, iou, albedo_diff, delta_e, ratio[R_COUNT], band;
     double band_low, band_high;  // the band below the lips' lowest row (under the jaw) and above it
+    double band_outline, band_inner;  // within 4 px of the outline, and at depth steps inside the face
+    double band_noise;  // the path tracer's sampling noise on the band's ratio (one standard error)
     double forehead, highlights;  // path tracer / rouge: specular-dominated areas (diagnostics, not goals)
     double glare;                 // % of face pixels where rouge is brighter by dE > 10 (a sheen the reference lacks)
     int region_px[R_COUNT], band_px, band_low_px;
@@ -362,7 +366,7 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
                     if (yy >= 0 && yy < h && xx >= 0 && xx < w && !face_px[(size_t)yy * w + xx])
                         edge_px[(size_t)y * w + x] = 1;
                 }
-    double reg[R_COUNT][2] = {{0}}, band[2] = {0}, band_low[2] = {0};
+    double reg[R_COUNT][2] = {{0}}, band[2] = {0}, band_low[2] = {0}, band_out[2] = {0}, band_var = 0;
     memset(res->region_px, 0, sizeof res->region_px);
     res->band_px = res->band_low_px = 0;
     size_t jaw_row = n;  // first pixel index below the lips' lowest row (n: no lips in view)
@@ -379,6 +383,22 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
             res->band_px++;
             in_band[i] = 1;
             if (i >= jaw_row) band_low[0] += lum(ro + i * 3), band_low[1] += lum(pt + i * 3), res->band_low_px++;
+            int x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
+            bool outline = false;
+            for (int dy = -4; dy <= 4 && !outline; dy++)
+                for (int dx = -4; dx <= 4 && !outline; dx++) {
+                    int xx = x + dx, yy = y + dy;
+                    outline = xx < 0 || yy < 0 || xx >= w || yy >= h || t->alpha[(size_t)yy * w + xx] < 128;
+                }
+            if (outline) band_out[0] += lum(ro + i * 3), band_out[1] += lum(pt + i * 3);
+            // The reference's per-pixel Monte Carlo noise: what is left of its luminance after the straight
+            // line through its two neighbours (across or along, whichever is smoother), whose variance is
+            // 1.5 sigma^2 for independent noise.
+            if (x > 0 && y > 0 && x < w - 1 && y < h - 1) {
+                double ph = lum(pt + i * 3) - 0.5 * (lum(pt + (i - 1) * 3) + lum(pt + (i + 1) * 3));
+                double pv = lum(pt + i * 3) - 0.5 * (lum(pt + (i - (size_t)w) * 3) + lum(pt + (i + (size_t)w) * 3));
+                band_var += fmin(ph * ph, pv * pv) / 1.5;
+            }
         }
     }
     for (int r = 0; r < R_COUNT; r++) res->ratio[r] = reg[r][1] > 0 ? reg[r][0] / reg[r][1] : 0.0;
@@ -405,6 +425,9 @@ static bool measure(const char *env, const truth *t, result *res, const char *pn
     res->band = band[1] > 0 ? band[0] / band[1] : 0.0;
     res->band_low = band_low[1] > 0 ? band_low[0] / band_low[1] : 0.0;
     res->band_high = band[1] - band_low[1] > 0 ? (band[0] - band_low[0]) / (band[1] - band_low[1]) : 0.0;
+    res->band_outline = band_out[1] > 0 ? band_out[0] / band_out[1] : 0.0;
+    res->band_inner = band[1] - band_out[1] > 0 ? (band[0] - band_out[0]) / (band[1] - band_out[1]) : 0.0;
+    res->band_noise = band[1] > 0 ? res->band * sqrt(band_var) / band[1] : 0.0;
     // rouge | path tracer | dE | band map (all over black).
     rs_image side = {0};
     if (rs_image_create(4 * w, h, 3, &side, NULL) == RS_OK) {
@@ -454,9 +477,10 @@ static void test_view(void)
            ref->env, ref->view, r.k, r.iou, r.albedo_diff, r.delta_e);
     for (int i = 0; i < R_COUNT; i++)
         if (r.region_px[i] >= 20) printf(" %s %.3f", region_names[i], r.ratio[i]);
-    printf("; contour band rouge / path tracer %.3f (%d px: under the jaw %.3f, %d px; above it %.3f); specular"
-           " areas, path tracer / rouge: forehead %.3f highlights %.3f; glare %.2f %% of the face\n", r.band,
-           r.band_px, r.band_low, r.band_low_px, r.band_high, r.forehead, r.highlights, r.glare);
+    printf("; contour band rouge / path tracer %.3f +- %.3f (%d px: under the jaw %.3f, %d px; above it %.3f; along"
+           " the outline %.3f, at inner depth steps %.3f); specular areas, path tracer / rouge: forehead %.3f"
+           " highlights %.3f; glare %.2f %% of the face\n", r.band, r.band_noise, r.band_px, r.band_low,
+           r.band_low_px, r.band_high, r.band_outline, r.band_inner, r.forehead, r.highlights, r.glare);
     // The fixture is the scene rouge renders: same camera and outline, same albedo.
     RS_CHECK(r.iou >= 0.98, "silhouettes differ: IoU %.4f", r.iou);
     // albedo_diff -1: not checked under this environment.
