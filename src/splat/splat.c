@@ -44,49 +44,11 @@ void rs_splat_decode_normal(uint32_t code, float n[3])
 
 static uint32_t pack_snorm16x2(int u, int v) { return (uint32_t)(u & 0xffff) | (uint32_t)(v & 0xffff) << 16; }
 
-// Precise encode: of the four codes around the projected point, keep the one whose *decoded* normal is
-// closest in angle (plain rounding can be ~2x worse near the fold edges).
-uint32_t rs_splat_encode_normal(const float n[3])
+// The unit direction (x, y, z) on the lattice of codes that are multiples of `step` (a power of two),
+// within +-(32767 rounded down to it): of the four codes around the projected point, the one whose
+// *decoded* normal is closest in angle (plain rounding can be ~2x worse near the fold edges).
+static uint32_t encode_normal_on(double x, double y, double z, int step)
 {
-    double x = n[0], y = n[1], z = n[2];
-    double len = sqrt(x * x + y * y + z * z);
-    if (!(len > 0.0) || !isfinite(len)) return pack_snorm16x2(0, 0);  // +z; callers validate first
-    x /= len, y /= len, z /= len;
-    double l1 = fabs(x) + fabs(y) + fabs(z);
-    double u = x / l1, v = y / l1;
-    if (z < 0.0) {
-        double fu = (1.0 - fabs(v)) * sign_not_zero(u);
-        double fv = (1.0 - fabs(u)) * sign_not_zero(v);
-        u = fu;
-        v = fv;
-    }
-    int u0 = (int)floor(u * 32767.0), v0 = (int)floor(v * 32767.0);
-    uint32_t best = 0;
-    double best_dot = -2.0;
-    for (int k = 0; k < 4; k++) {
-        int cu = RS_CLAMP(u0 + (k & 1), -32767, 32767);
-        int cv = RS_CLAMP(v0 + (k >> 1), -32767, 32767);
-        uint32_t code = pack_snorm16x2(cu, cv);
-        float d[3];
-        rs_splat_decode_normal(code, d);
-        // Renormalised in double: the float decode's length error (~1e-7) exceeds 1 - cos(error) (~1e-9).
-        double dl = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
-        double dot = (x * d[0] + y * d[1] + z * d[2]) / dl;
-        if (dot > best_dot) {
-            best_dot = dot;
-            best = code;
-        }
-    }
-    return best;
-}
-
-// The same search on the lattice of codes that are multiples of `step` (a power of two), within
-// +-(32767 rounded down to it): every candidate is a code a 16-bit reader decodes as is.
-static uint32_t encode_normal_lattice(const float n[3], int step)
-{
-    float d[3];
-    rs_splat_decode_normal(rs_splat_encode_normal(n), d);
-    double x = d[0], y = d[1], z = d[2];
     double l1 = fabs(x) + fabs(y) + fabs(z);
     double u = x / l1, v = y / l1;
     if (z < 0.0) {
@@ -103,16 +65,33 @@ static uint32_t encode_normal_lattice(const float n[3], int step)
         int cu = RS_CLAMP(u0 + (k & 1) * step, -lim, lim);
         int cv = RS_CLAMP(v0 + (k >> 1) * step, -lim, lim);
         uint32_t code = pack_snorm16x2(cu, cv);
-        float e[3];
-        rs_splat_decode_normal(code, e);
-        double el = sqrt((double)e[0] * e[0] + (double)e[1] * e[1] + (double)e[2] * e[2]);
-        double dot = (x * e[0] + y * e[1] + z * e[2]) / el;
+        float d[3];
+        rs_splat_decode_normal(code, d);
+        // Renormalised in double: the float decode's length error (~1e-7) exceeds 1 - cos(error) (~1e-9).
+        double dl = sqrt((double)d[0] * d[0] + (double)d[1] * d[1] + (double)d[2] * d[2]);
+        double dot = (x * d[0] + y * d[1] + z * d[2]) / dl;
         if (dot > best_dot) {
             best_dot = dot;
             best = code;
         }
     }
     return best;
+}
+
+uint32_t rs_splat_encode_normal(const float n[3])
+{
+    double x = n[0], y = n[1], z = n[2];
+    double len = sqrt(x * x + y * y + z * z);
+    if (!(len > 0.0) || !isfinite(len)) return pack_snorm16x2(0, 0);  // +z; callers validate first
+    return encode_normal_on(x / len, y / len, z / len, 1);
+}
+
+// A normal as the 16-bit code decodes it, re-encoded on the coarser lattice of multiples of `step`.
+static uint32_t encode_normal_lattice(const float n[3], int step)
+{
+    float d[3];
+    rs_splat_decode_normal(rs_splat_encode_normal(n), d);
+    return encode_normal_on(d[0], d[1], d[2], step);
 }
 
 void rs_splat_quantize_normals(rs_splat_cloud *c, int bits)
