@@ -338,8 +338,9 @@ static rs_result guard_xml(const uint8_t *d, size_t n, bool collada, const char 
         i = e;
     }
     if (r == RS_OK && collada && g.count) {
-        qsort(ids, id_count, sizeof *ids, cmp_id);
-        for (size_t k = 0; k < ref_count && r == RS_OK; k++) {
+        // With no node ids, ids is NULL, which qsort and bsearch must not be given (and no reference can hit).
+        if (id_count) qsort(ids, id_count, sizeof *ids, cmp_id);
+        for (size_t k = 0; k < ref_count && id_count && r == RS_OK; k++) {
             xml_id *hit = bsearch(&refs[k], ids, id_count, sizeof *ids, cmp_id);
             if (hit && !graph_edge(&g, refs[k].node, hit->node)) r = rs_fail(err, RS_ERR_NOMEM, "out of memory");
         }
