@@ -231,6 +231,13 @@ static void test_guard_refuses_hostile_structure(void)
     // a null pointer, undefined behaviour): nothing to resolve, not an error.
     static const char no_ids[] = "<COLLADA><library_nodes><node><instance_node url=\"#n\"/></node></library_nodes></COLLADA>";
     RS_CHECK(rs_import_guard(no_ids, sizeof no_ids - 1, RS_IMPORT_OTHER, "x", &err) == RS_OK, "%s", err.msg);
+    // An image whose mimeType has no '/' (make fuzz's find: assimp then read from address 1 and crashed) is
+    // refused before assimp sees it; a proper one passes.
+    static const char mime_bad[] = "{\"asset\":{\"version\":\"2.0\"},\"images\":[{\"bufferView\":0, \"mimeType\" : \"image?png\"}]}";
+    static const char mime_ok[] = "{\"asset\":{\"version\":\"2.0\"},\"images\":[{\"bufferView\":0,\"mimeType\":\"image/png\"}]}";
+    RS_CHECK(rs_import_guard(mime_bad, sizeof mime_bad - 1, RS_IMPORT_GLTF, "x", &err) == RS_ERR_FORMAT &&
+                 strstr(err.msg, "mimeType is not of the form type/subtype"), "%s", err.msg);
+    RS_CHECK(rs_import_guard(mime_ok, sizeof mime_ok - 1, RS_IMPORT_GLTF, "x", &err) == RS_OK, "%s", err.msg);
     free(data);
     free(deep);
     free(dae);

@@ -1009,8 +1009,8 @@ static rs_result import_in_child(const char *path, const rs_import_desc *desc, c
     if (WIFSIGNALED(status)) {
         int sig = WTERMSIG(status);
         if (sig == SIGSEGV || sig == SIGBUS)
-            return rs_fail(err, RS_ERR_FORMAT, "%s: assimp crashed reading it (signal %d, %s: most likely a stack overflow on "
-                                               "nodes nested too deeply or a node that contains itself); not read",
+            return rs_fail(err, RS_ERR_FORMAT, "%s: assimp crashed reading it (signal %d, %s: a fault in assimp's "
+                                               "reader, e.g. a stack overflow on nodes nested too deeply); not read",
                            path, sig, sig == SIGSEGV ? "SIGSEGV" : "SIGBUS");
         if (sig == SIGXCPU)
             return rs_fail(err, RS_ERR_LIMIT, "%s: reading it took more than %d s of CPU time (a work bomb?); not read", path,

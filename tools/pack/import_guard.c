@@ -351,7 +351,9 @@ static rs_result guard_xml(const uint8_t *d, size_t n, bool collada, const char 
 }
 
 // glTF: the "nodes" array of the top-level object, each node's "children" indices. A small scanner for
-// just that: strings skipped, depth tracked, numbers read where "children" is open.
+// just that: strings skipped, depth tracked, numbers read where "children" is open. Also every
+// "mimeType" value: assimp 5.2 takes an embedded image's file type from after its '/', and one without
+// a '/' made it read from address 1 (a crash, found by make fuzz).
 static rs_result guard_gltf_nodes(const uint8_t *d, size_t n, const char *name, rs_error *err)
 {
     graph g = {0};
@@ -359,14 +361,24 @@ static rs_result guard_gltf_nodes(const uint8_t *d, size_t n, const char *name, 
     int depth = 0, nodes_depth = -1, children_depth = -1;
     const uint8_t *key = NULL;  // the last string at object level (a key when a ':' follows)
     size_t key_len = 0;
+    bool mime = false;  // a ':' after the key "mimeType": the next string is its value
     for (size_t i = 0; i < n && r == RS_OK; i++) {
         uint8_t c = d[i];
         if (c == '"') {
             size_t s = ++i;
             while (i < n && d[i] != '"') i += d[i] == '\\' ? 2 : 1;
             key = d + s, key_len = RS_MIN(i, n) - s;
+            if (mime && !memchr(key, '/', key_len))
+                r = rs_fail(err, RS_ERR_FORMAT, "%s: a glTF image's mimeType is not of the form type/subtype; not read",
+                            name);
+            mime = false;
             continue;
         }
+        if (c == ':') {
+            mime = key && key_len == 8 && !memcmp(key, "mimeType", 8);
+            continue;
+        }
+        if (c != ' ' && c != '\t' && c != '\r' && c != '\n') mime = false;
         if (c == '{' || c == '[') {
             depth++;
             bool named = key && key_len > 0;
