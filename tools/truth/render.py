@@ -3,16 +3,18 @@
 #
 #   blender -b --factory-startup --python tools/truth/render.py -- SCENE_DIR DATA_DIR ENV SAMPLES OUT_DIR
 #
-# SCENE_DIR: rouge-truth-scene's output (scene.json: rouge's cameras, region table, skin profile radius;
-# env_ENV.hdr: the environment turned and scaled as rouge sees it; splats.f32: the splats' regions).
+# SCENE_DIR: rouge-truth-scene's output (scene.json: rouge's cameras, region table; env_ENV.hdr: the
+# environment turned and scaled as rouge sees it; splats.f32: the splats' regions) and sss_calibrate.py's
+# (sss.json: the subsurface radius that scatters like rouge's skin profile).
 # DATA_DIR: ../shared/data/leeperrysmith (head_mesh.ply, color.png, normal.png: what face.rsf was made from).
 # Writes OUT_DIR/ENV_VIEW.rtf for every view (the uncompressed fixture, tests/fixtures/truth/README.md).
 #
 # The scene: the mesh in rouge's model coordinates (+y up, the face towards +z; Blender's own up axis plays no
 # part), its vertex normals perturbed by the tangent-space normal map as the splats' were; a Principled BSDF
-# with random-walk subsurface scattering: albedo = color.png, radius = the skin profile's mean scattering
-# distance per channel, F0 and roughness per region from the .rsf's region table; the world is the
-# environment map looked up with the env frame's own mapping (docs/env.md), not Blender's.
+# with random-walk subsurface scattering: albedo = color.png, radius = the one that carries as much light
+# past a shadow's edge as the skin profile (sss.json), F0 and roughness per region from the .rsf's region
+# table; the world is the environment map looked up with the env frame's own mapping (docs/env.md), not
+# Blender's.
 import json
 import math
 import os
@@ -27,6 +29,7 @@ from mathutils.kdtree import KDTree
 argv = sys.argv[sys.argv.index("--") + 1:]
 scene_dir, data_dir, env_name, samples, out_dir = argv[0], argv[1], argv[2], int(argv[3]), argv[4]
 S = json.load(open(os.path.join(scene_dir, "scene.json")))
+SSS = json.load(open(os.path.join(scene_dir, "sss.json")))  # sss_calibrate.py
 size = S["size"]
 env = next(e for e in S["envs"] if e["name"] == env_name)
 F0_SKIN = 0.028          # skin, n = 1.4 (rouge's RS_F0_SKIN)
@@ -117,7 +120,7 @@ def skin_material():
     bsdf.subsurface_method = "RANDOM_WALK"
     bsdf.inputs["Subsurface"].default_value = 1.0   # full subsurface; also the radius' multiplier
     mm = S["mm_per_unit"]
-    bsdf.inputs["Subsurface Radius"].default_value = [r / mm for r in S["sss_radius_mm"]]
+    bsdf.inputs["Subsurface Radius"].default_value = [r / mm for r in SSS["radius_mm"]]
     bsdf.inputs["Subsurface IOR"].default_value = 1.4
     bsdf.inputs["Subsurface Anisotropy"].default_value = 0.0
     bsdf.inputs["Sheen"].default_value = 0.0

@@ -1,11 +1,11 @@
 #!/bin/sh
 # make truth: the path-traced reference of the bundled head (tests/fixtures/truth/README.md). Renders every bundled
 # environment x view with Blender Cycles and writes tests/fixtures/truth/ENV_VIEW.rtf.zst. Slow (about
-# TRUTH_SAMPLES x 0.3 s of CPU a view); never part of make test.
-#   sh tools/truth/truth.sh BUILD_DIR        TRUTH_SAMPLES (512), TRUTH_ENVS ("studio daylight office sunset")
+# TRUTH_SAMPLES x 0.4 s of CPU a view, plus 2 CPU-minutes calibrating the subsurface); never part of make test.
+#   sh tools/truth/truth.sh BUILD_DIR        TRUTH_SAMPLES (1024), TRUTH_ENVS ("studio daylight office sunset")
 set -eu
 build=${1:-build}
-samples=${TRUTH_SAMPLES:-512}
+samples=${TRUTH_SAMPLES:-1024}
 envs=${TRUTH_ENVS:-studio daylight office sunset}
 size=256
 data=../shared/data/leeperrysmith
@@ -26,6 +26,14 @@ command -v zstd >/dev/null 2>&1 || { echo "make truth: no zstd (make truth-deps)
 
 mkdir -p "$out" "$fixtures"
 "$build/rouge-truth-scene" assets/face.rsf assets/env "$exr" "$out" "$size"
+echo "make truth: the subsurface radius that scatters like rouge's skin profile"
+if ! nice -n 15 blender -b --factory-startup --python-exit-code 1 --python tools/truth/sss_calibrate.py -- \
+        "$out" "$data" 512 >"$out/sss.log" 2>&1; then
+    tail -n 20 "$out/sss.log" >&2
+    echo "make truth: blender failed calibrating the subsurface radius (log: $out/sss.log)" >&2
+    exit 1
+fi
+grep '^sss_calibrate: radius' "$out/sss.log"
 for env in $envs; do
     echo "make truth: $env ($samples samples a pixel)"
     if ! nice -n 15 blender -b --factory-startup --python-exit-code 1 --python tools/truth/render.py -- \

@@ -215,14 +215,20 @@ int main(int argc, char **argv)
     }
     if (r == RS_OK) {
         const rs_splat_header *h = &cloud->hdr;
-        // The skin profile's mean scattering distance per channel: a 2D Gaussian of variance v has mean
-        // radius sqrt(pi v / 2); Cycles' subsurface radius is the average distance light scatters.
+        // What the skin profile carries into a shadow per channel: behind a straight shadow edge on a flat
+        // surface, the integral of the lit fraction over the shadow side, mm. A 2D Gaussian of variance v
+        // gives sqrt(v / (2 pi)) (half the mean |x| of its line spread); the profile, its weighted mean.
+        // sss_calibrate.py finds the Cycles subsurface radius that carries as much (issue 22).
         rs_profile p = rs_profile_deon();
-        float radius[3] = {0};
+        float edge[3] = {0}, wsum[3] = {0};
         for (int i = 0; i < p.count; i++)
-            for (int c = 0; c < 3; c++) radius[c] += p.weight[i][c] * sqrtf((float)PI * p.variance_mm2[i] / 2.0f);
-        fprintf(f, "{\n  \"size\": %d,\n  \"mm_per_unit\": %.9g,\n  \"sss_radius_mm\": ", size, h->mm_per_unit);
-        put_floats(f, radius, 3);
+            for (int c = 0; c < 3; c++) {
+                edge[c] += p.weight[i][c] * sqrtf(p.variance_mm2[i] / (2.0f * (float)PI));
+                wsum[c] += p.weight[i][c];
+            }
+        for (int c = 0; c < 3; c++) edge[c] /= wsum[c] > 0.0f ? wsum[c] : 1.0f;
+        fprintf(f, "{\n  \"size\": %d,\n  \"mm_per_unit\": %.9g,\n  \"sss_edge_mm\": ", size, h->mm_per_unit);
+        put_floats(f, edge, 3);
         fprintf(f, ",\n  \"centre\": ");
         put_floats(f, h->centre, 3);
         fprintf(f, ",\n  \"forward\": ");
