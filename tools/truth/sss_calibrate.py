@@ -15,7 +15,6 @@
 # behind a straight shadow edge per step, the radius scaled by target / measured, twice (the second step
 # corrects the first one's noise), and a last render reports what the chosen radius carries.
 import json
-import math
 import os
 import sys
 
