@@ -1148,6 +1148,10 @@ static rs_result poll_loader(vw_viewer *v, rs_error *err)
     return RS_OK;
 }
 
+// A load ends when its face is swapped in (the stream is dropped then), not when its thread ends: making the
+// face of the decoded splats takes a frame more, and a script's `loaded` once shot the preview meanwhile.
+static bool loading(const vw_viewer *v) { return v->load.stream != NULL; }
+
 // The picture on screen is the full-quality one and nothing is about to change it.
 static bool at_full_quality(const vw_viewer *v)
 {
@@ -1207,7 +1211,7 @@ static rs_result run(vw_viewer *v, rs_error *err)
     v->load.initial = true;
     vw_options o = viewer_options(c);
     // Loading screen until the face (or a preview of it) is there; the bench waits for all of it.
-    while (!v->face || (o.bench_orbit > 0 && v->load.running)) {
+    while (!v->face || (o.bench_orbit > 0 && loading(v))) {
         if (glfwWindowShouldClose(v->win)) {
             load_abort(v);
             return RS_OK;
@@ -1235,7 +1239,7 @@ static rs_result run(vw_viewer *v, rs_error *err)
         vw_script_step step = {0};
         if (v->have_script) {
             int next0 = v->script.next, frames0 = v->script.frames_left;
-            vw_script_run(&v->script, &v->queue, settled(v), v->load.running, vw_now(), &step);
+            vw_script_run(&v->script, &v->queue, settled(v), loading(v), vw_now(), &step);
             if (step.quit) v->quit = true;
             if (v->script.done && !step.quit && !step.screenshot) v->have_script = false;
             // A script waiting (on its clock, a file, a load) with nothing to show draws no frame: the
