@@ -217,16 +217,13 @@ int main(int argc, char **argv)
         const rs_splat_header *h = &cloud->hdr;
         // What the skin profile carries into a shadow per channel: behind a straight shadow edge on a flat
         // surface, the integral of the lit fraction over the shadow side, mm. A 2D Gaussian of variance v
-        // gives sqrt(v / (2 pi)) (half the mean |x| of its line spread); the profile, its weighted mean.
-        // sss_calibrate.py finds the Cycles subsurface radius that carries as much (issue 22).
+        // gives sqrt(v / (2 pi)) (half the mean |x| of its line spread); the profile (weights summing to 1
+        // per channel), their weighted sum. sss_calibrate.py finds the Cycles subsurface radius that carries
+        // as much (issue 22).
         rs_profile p = rs_profile_deon();
-        float edge[3] = {0}, wsum[3] = {0};
+        float edge[3] = {0};
         for (int i = 0; i < p.count; i++)
-            for (int c = 0; c < 3; c++) {
-                edge[c] += p.weight[i][c] * sqrtf(p.variance_mm2[i] / (2.0f * (float)PI));
-                wsum[c] += p.weight[i][c];
-            }
-        for (int c = 0; c < 3; c++) edge[c] /= wsum[c] > 0.0f ? wsum[c] : 1.0f;
+            for (int c = 0; c < 3; c++) edge[c] += p.weight[i][c] * sqrtf(p.variance_mm2[i] / (2.0f * (float)PI));
         fprintf(f, "{\n  \"size\": %d,\n  \"mm_per_unit\": %.9g,\n  \"sss_edge_mm\": ", size, h->mm_per_unit);
         put_floats(f, edge, 3);
         fprintf(f, ",\n  \"centre\": ");
