@@ -4,6 +4,7 @@
 // no writes) against the visibility pass, so only the front surface layer accumulates.
 //   RT0 = (albedo, 1) w      RT1 = (normal * 0.5 + 0.5, m) w
 //   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w, or (rho_s, debug colour) w in the debug views
+//   RT3 = (bent normal * 0.5 + 0.5, 0) w (the axis of the sky the surface sees; env_light.glsl rs_env_sky)
 // Normals are stored offset to 0..1 so the RGBA8 fallback needs no signed format; u_weight_scale keeps the
 // fallback's sums below 1 (it cancels in the division) and u_weight_floor keeps a disk's rim from
 // rounding to nothing where it alone covers a pixel (next to occluding edges).
@@ -24,11 +25,13 @@ flat in vec3 v_albedo;
 flat in vec2 v_spec;
 flat in vec3 v_debug;
 flat in vec3 v_layers;
+flat in vec3 v_bent;
 uniform int u_debug;
 
 layout(location = 0) out vec4 o_albedo;
 layout(location = 1) out vec4 o_normal;
 layout(location = 2) out vec4 o_extra;
+layout(location = 3) out vec4 o_bent;
 
 void main()
 {
@@ -41,4 +44,5 @@ void main()
     o_albedo = vec4(v_albedo, 1.0) * w;
     o_normal = vec4(v_n * 0.5 + 0.5, v_spec.x) * w;
     o_extra = vec4(v_spec.y, u_debug != 0 ? v_debug : v_layers) * w;
+    o_bent = vec4(v_bent * 0.5 + 0.5, 0.0) * w;
 }

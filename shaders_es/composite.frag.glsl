@@ -31,6 +31,7 @@ precision highp int;
 uniform highp sampler2D u_attr0;
 uniform highp sampler2D u_attr1;
 uniform highp sampler2D u_attr2;
+uniform highp sampler2D u_attr3;
 uniform highp sampler2D u_diffuse;
 uniform int u_mode;
 uniform int u_physical;         // 1: F = A D + S
@@ -170,9 +171,9 @@ vec3 linear_to_srgb(vec3 c)
 // is a gap between splats (a sparse spot of a random sampling, a crease seen edge-on), not background.
 // The attribute targets hold weighted sums, so adding the neighbours' sums and normalising once gives
 // their weighted mean; the surface point and D are the neighbours' means.
-bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out vec4 D)
+bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec4 t3, out vec3 p, out vec4 D)
 {
-    t0 = t1 = t2 = vec4(0.0);
+    t0 = t1 = t2 = t3 = vec4(0.0);
     p = vec3(0.0);
     D = vec4(0.0);
     ivec2 hi = ivec2(u_viewport) - 1;
@@ -194,6 +195,7 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec3 p, out 
         t0 += a;
         t1 += texelFetch(u_attr1, q, 0);
         t2 += texelFetch(u_attr2, q, 0);
+        t3 += texelFetch(u_attr3, q, 0);
         p += pq;
         D += texelFetch(u_diffuse, q, 0);
         k++;
@@ -326,7 +328,7 @@ float coverage(ivec2 px)
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 t0 = texelFetch(u_attr0, px, 0), t1, t2;
+    vec4 t0 = texelFetch(u_attr0, px, 0), t1, t2, t3;
     vec3 p;
     vec4 D;
     float alpha = 1.0;
@@ -334,8 +336,9 @@ void main()
         alpha = coverage(px);
         t1 = texelFetch(u_attr1, px, 0);
         t2 = texelFetch(u_attr2, px, 0);
+        t3 = texelFetch(u_attr3, px, 0);
         D = texelFetch(u_diffuse, px, 0);
-    } else if (!fill_hole(px, t0, t1, t2, p, D)) {
+    } else if (!fill_hole(px, t0, t1, t2, t3, p, D)) {
         o_color = vec4(u_background, 1.0);
         return;
     }
@@ -384,7 +387,7 @@ void main()
             float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
-            E += rs_env_irradiance(N) * ao + rs_env_lamp_irradiance(N, vis);
+            E += rs_env_sky(N, normalize(t3.xyz * inv * 2.0 - 1.0), ao) + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
             Eb = rs_bounce(ao, A);

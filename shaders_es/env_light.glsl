@@ -15,6 +15,7 @@ uniform float u_env_m[8];
 uniform int u_env_levels;
 uniform float u_env_scale;          // exposure normalisation of the map (the SH carry theirs)
 uniform highp sampler2D u_spec_lut; // (N.V, m) -> (A, B): the lobe's directional albedo is F0 A + B
+uniform float u_env_cones;          // 1: the splats carry bent normals (RS_SPLAT_FLAG_BENT): rs_env_sky's cones
 
 // The SH's irradiance (the environment without its key light and lamps) at view-space normal n_view.
 vec3 rs_env_irradiance(vec3 n_view)
@@ -26,6 +27,26 @@ vec3 rs_env_irradiance(vec3 n_view)
            + u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
            + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
            + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y));
+    return max(e, vec3(0.0));
+}
+
+// The SH's irradiance on a surface of normal n_view that sees the sky only through a cone around b_view
+// (its bent normal) holding the (cosine-weighted) share ao of its hemisphere: a bent cone (Klehm et al.
+// 2014). The cone is the cosine lobe cut at the half-angle t with sin^2 t = ao; each SH band is scaled by
+// that cut lobe's zonal coefficient over the whole lobe's: ao (band 0), 1 - cos^3 t (band 1),
+// 1 - 3 cos^4 t + 2 cos^2 t (band 2), all 1 in the open. A hollow's light comes from where its opening
+// looks (a nostril's roof sees the ground, the jaw's underside the horizon), and a narrow opening lights
+// it more directionally. Without bent normals: the hemisphere around n scaled by ao, as before.
+vec3 rs_env_sky(vec3 n_view, vec3 b_view, float ao)
+{
+    if (u_env_cones < 0.5) return rs_env_irradiance(n_view) * ao;
+    vec3 n = u_env_from_view * b_view;
+    float c2 = 1.0 - ao, s1 = 1.0 - c2 * sqrt(c2), s2 = 1.0 - 3.0 * c2 * c2 + 2.0 * c2;
+    vec3 e = u_env_sh[0] * (0.282095 * ao)
+           + (u_env_sh[1] * (0.488603 * n.y) + u_env_sh[2] * (0.488603 * n.z) + u_env_sh[3] * (0.488603 * n.x)) * s1
+           + (u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
+              + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
+              + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y))) * s2;
     return max(e, vec3(0.0));
 }
 

@@ -4,6 +4,7 @@ uniform vec3 u_bbox_min;      // quantization frame, model units
 uniform vec3 u_bbox_step;     // (bbox_max - bbox_min) / 65535
 uniform vec2 u_radius_log;    // radius = u_radius_log.x * exp(u_radius_log.y * q), q = 0..255
 uniform float u_has_ao;       // 1: byte 15 of the record is the splat's ambient occlusion (RS_SPLAT_FLAG_AO)
+uniform float u_has_bent;     // 1: the low 6 bits of each half of w.z are the bent normal (RS_SPLAT_FLAG_BENT)
 
 struct rs_splat {
     vec3 pos;       // model units
@@ -12,6 +13,7 @@ struct rs_splat {
     vec3 albedo;    // linear RGB
     uint region;
     float ao;       // ambient occlusion, 1 = open sky (1 when the file has none)
+    vec3 bent;      // unit, the axis of the sky it sees (the normal when the file has none)
 };
 
 float rs_snorm16(uint bits)
@@ -32,6 +34,21 @@ vec3 rs_decode_normal(uint code)
     return normalize(vec3(e, z));
 }
 
+// The bent normal: a turn away from n along its tangents (rs_splat_bent, splat.c: Duff et al. 2017's
+// basis), by 90 deg x rho^1.5 for the snorm6 pair's length rho.
+vec3 rs_decode_bent(uint code, vec3 n)
+{
+    ivec2 q = ivec2(int(code & 63u), int((code >> 16) & 63u));
+    q -= 64 * ivec2(greaterThanEqual(q, ivec2(32)));
+    vec2 x = vec2(q) / 31.0;
+    float rho = length(x);
+    if (rho == 0.0) return n;
+    float sg = n.z < 0.0 ? -1.0 : 1.0, a = -1.0 / (sg + n.z), b = n.x * n.y * a;
+    vec3 t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), t2 = vec3(b, sg + n.y * n.y * a, -n.y);
+    float r = min(rho, 1.0), angle = r * sqrt(r) * 1.5707963;
+    return normalize(cos(angle) * n + (sin(angle) / rho) * (x.x * t1 + x.y * t2));
+}
+
 vec3 rs_srgb_to_linear(vec3 c)
 {
     return mix(pow((c + 0.055) / 1.055, vec3(2.4)), c / 12.92, step(c, vec3(0.04045)));  // linear at and below
@@ -44,7 +61,9 @@ rs_splat rs_decode_splat(uvec4 w)
     s.radius = u_radius_log.x * exp(u_radius_log.y * float((w.y >> 16) & 0xffu));
     s.region = w.y >> 24;
     s.ao = u_has_ao > 0.5 ? float(w.w >> 24) / 255.0 : 1.0;
-    s.normal = rs_decode_normal(w.z);
+    bool bent = u_has_bent > 0.5;
+    s.normal = rs_decode_normal(bent ? w.z & 0xffc0ffc0u : w.z);
+    s.bent = bent ? rs_decode_bent(w.z, s.normal) : s.normal;
     s.albedo = rs_srgb_to_linear(vec3(float(w.w & 0xffu), float((w.w >> 8) & 0xffu),
                                       float((w.w >> 16) & 0xffu)) / 255.0);
     return s;

@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#define PI 3.14159265358979323846
+
 static float dot3(const float a[3], const float b[3])
 {
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
@@ -228,18 +230,41 @@ static void test_normals_on_demosthenes_agree_with_given(void)
     rs_ply_destroy(m);
 }
 
+// The cosine-weighted mean open direction of a floor point d in front of the middle of a wall (x = 0, 8
+// long, 1 high): the direction's angle from +z towards +x (away from the wall), by quadrature.
+static double wall_bent_deg(double d)
+{
+    double sx = 0, sz = 0;
+    enum { T = 400, P = 800 };
+    for (int i = 0; i < T; i++)
+        for (int j = 0; j < P; j++) {
+            double th = (i + 0.5) * (PI / 2) / T, ph = (j + 0.5) * 2 * PI / P;
+            double w[3] = {sin(th) * cos(ph), sin(th) * sin(ph), cos(th)};
+            if (w[0] < 0) {
+                double t = d / -w[0];
+                if (fabs(t * w[1]) <= 4 && t * w[2] <= 1) continue;  // hits the wall
+            }
+            double wt = cos(th) * sin(th);  // cosine times the solid angle's sin(theta)
+            sx += w[0] * wt, sz += w[2] * wt;
+        }
+    return atan2(sx, sz) * 180 / PI;
+}
+
 // Ambient occlusion (pack_ao.c) against analytic answers: a flat floor sees the whole upper hemisphere
 // (1); the bottom of a hemispherical bowl sees the sky through its rim at 45 degrees from the axis, a
 // cosine-weighted fraction of sin^2(45) = 0.5; a floor point at distance d from the foot of a long wall
 // of height h misses the wall's form factor, AO = 1/2 + d / (2 sqrt(d^2 + h^2)); a splat under a lid
-// sees nothing above it but what slips in under the lid's edge.
+// sees nothing above it but what slips in under the lid's edge. The bent normals (the mean open
+// direction): the floor's and the bowl bottom's straight up, the wall's tilted away from it as the
+// quadrature above has it.
 static void test_ambient_occlusion_matches_analytic_cases(void)
 {
     enum { K = 60, BOWL = 4000, WALL_X = 200, WALL_Z = 50, LID = 40 };
     size_t cap = K * K + BOWL + WALL_X * (WALL_Z + 3) + LID * LID + 1, n = 0;
     rs_splat *s = calloc(cap, sizeof *s);
     uint8_t *ao = malloc(cap);
-    RS_REQUIRE(s && ao, "out of memory");
+    float(*bent)[3] = malloc(sizeof *bent * cap);
+    RS_REQUIRE(s && ao && bent, "out of memory");
     // A floor (z = 0, normal +z), 2 x 2 units, well away from the rest.
     for (int y = 0; y < K; y++)
         for (int x = 0; x < K; x++) {
@@ -284,8 +309,14 @@ static void test_ambient_occlusion_matches_analytic_cases(void)
     s[n].pos[0] = -3.0f, s[n].pos[1] = -6.0f, s[n].normal[2] = 1.0f, s[n].radius = 0.02f;
     n++;
     rs_error err = {0};
-    RS_REQUIRE(rs_pack_ao(s, (uint32_t)n, ao, &err) == RS_OK, "%s", err.msg);
-    double floor_mean = 0;
+    RS_REQUIRE(rs_pack_ao(s, (uint32_t)n, ao, bent, &err) == RS_OK, "%s", err.msg);
+    double floor_mean = 0, floor_tilt = 0;
+    for (uint32_t i = K + 1; i < floor_end - K - 1; i++)  // the edges see under the floor's rim
+        if (i % K != 0 && i % K != K - 1) floor_tilt = fmax(floor_tilt, acos(fmin(bent[i][2], 1.0)) * 180 / PI);
+    double bowl_tilt = acos(fmin(bent[bottom][2], 1.0)) * 180 / PI;
+    printf("# bent normals: floor within %.2f deg of up, bowl bottom %.2f deg\n", floor_tilt, bowl_tilt);
+    RS_CHECK(floor_tilt < 1.0, "open floor: bent normal %.2f deg from the normal", floor_tilt);
+    RS_CHECK(bowl_tilt < 3.0, "bowl bottom: bent normal %.2f deg from the axis", bowl_tilt);
     for (uint32_t i = 0; i < floor_end; i++) floor_mean += ao[i] / 255.0;
     floor_mean /= floor_end;
     float b = ao[bottom] / 255.0f, lid = ao[under] / 255.0f;
@@ -298,9 +329,16 @@ static void test_ambient_occlusion_matches_analytic_cases(void)
         float d = wall_d[i], want = 0.5f + d / (2.0f * sqrtf(d * d + 1.0f)), got = ao[wall_probe + i] / 255.0f;
         printf("# %.2f from the foot of a wall as high: AO %.3f (%.3f)\n", d, got, want);
         RS_CHECK(fabsf(got - want) < 0.05f, "%.2f from a wall: AO %.3f, want %.3f", d, got, want);
+        const float *bw = bent[wall_probe + i];
+        double tilt = atan2(bw[0], bw[2]) * 180 / PI, want_tilt = wall_bent_deg(d);
+        printf("# %.2f from the wall: bent normal %.1f deg away from it (%.1f), %.1f deg along it\n", d, tilt,
+               want_tilt, asin(fabs(bw[1])) * 180 / PI);
+        RS_CHECK(fabs(tilt - want_tilt) < 3.0 && fabs(bw[1]) < 0.05, "%.2f from a wall: bent normal (%.3f %.3f %.3f), "
+                 "%.1f deg from up, want %.1f", d, bw[0], bw[1], bw[2], tilt, want_tilt);
     }
     free(s);
     free(ao);
+    free(bent);
 }
 
 // Work per splat is bounded however few and large the splats (issue 24: a 1,000-triangle model did not
@@ -319,7 +357,7 @@ static void test_ambient_occlusion_bounded_and_prefix_agrees(void)
     }
     rs_error err = {0};
     double t0 = rs_time_now();
-    RS_REQUIRE(rs_pack_ao(s, N, ao, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_pack_ao(s, N, ao, NULL, &err) == RS_OK, "%s", err.msg);
     double dt = rs_time_now() - t0;
     printf("# occlusion of %d splats 4x the cloud wide: %.2f s\n", N, dt);
     RS_CHECK(dt < 30.0, "took %.1f s", dt);
@@ -331,8 +369,8 @@ static void test_ambient_occlusion_bounded_and_prefix_agrees(void)
         s[i].normal[2] = 1.0f;
         if (s[i].pos[0] < 3 && s[i].pos[1] < 3 && i % 5 == 0) s[i].pos[2] = 0.3f, s[i].normal[2] = -1.0f;
     }
-    RS_REQUIRE(rs_pack_ao(s, N, ao_all, &err) == RS_OK, "%s", err.msg);
-    RS_REQUIRE(rs_pack_ao_prefix(s, N, N / 4, ao, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_pack_ao(s, N, ao_all, NULL, &err) == RS_OK, "%s", err.msg);
+    RS_REQUIRE(rs_pack_ao_prefix(s, N, N / 4, ao, NULL, &err) == RS_OK, "%s", err.msg);
     double diff = 0;
     for (int i = 0; i < N; i++) diff += abs(ao[i] - ao_all[i]) / 255.0;
     diff /= N;
@@ -966,10 +1004,10 @@ static void test_600k_scan_packs_to_at_most_8_bytes_per_splat(void)
     rs_splat_cloud *c = NULL, *d = NULL;
     RS_REQUIRE(rs_pack_convert(m, &(rs_pack_desc){.mm_per_unit = 47}, &c, NULL, &err) == RS_OK, "%s", err.msg);
     rs_ply_destroy(m);
-    bool lattice = true;
-    for (uint32_t i = 0; i < c->hdr.count; i++)
-        lattice &= (c->packed[i].w[2] & 0x000f000fu) == 0 && (c->packed[i].w[1] & 0x00030000u) == 0;
-    RS_CHECK(lattice, "normals / radii not on the %d / %d-bit lattices", RS_PACK_NORMAL_BITS, RS_PACK_RADIUS_BITS);
+    // The normals' low bits hold the bent normals (the normal itself: the code with them cleared).
+    bool lattice = (c->hdr.flags & RS_SPLAT_FLAG_BENT) != 0;
+    for (uint32_t i = 0; i < c->hdr.count; i++) lattice &= (c->packed[i].w[1] & 0x00030000u) == 0;
+    RS_CHECK(lattice, "no bent normals, or radii not on the %d-bit lattice", RS_PACK_RADIUS_BITS);
     void *data = NULL;
     size_t len = 0;
     RS_REQUIRE(rs_splat_save_memory(c, &data, &len, &err) == RS_OK, "%s", err.msg);

@@ -6,12 +6,16 @@
 // to one quantization step in every field (position, octahedral normal, log radius) and re-encoded in a
 // new bounding box: the float data and its quantization differ by at most half a step, this test by up
 // to a whole step.
+// Also the bent normals the low bits of the normal's code carry (RS_SPLAT_FLAG_BENT): where they are the
+// normal and the sky is wide open the environment's light is the one without them, to the bit.
 #include "support/harness.h"
+#include "formats/env.h"
 #include "render/render.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #define SIZE 512
 #define MAX_SPLATS 50000
@@ -38,6 +42,68 @@ static rs_result render(const rs_splat_cloud *c, rs_gl_context *gl, rs_image *ou
 
 static rs_gl_context *gl;
 
+// The bundled face's first 50k splats open to the sky (AO 255), with bent normals `tilt` of the way from
+// the normal to up (0: the normal itself), or none (tilt < 0); rendered under daylight.
+static rs_result render_sky(float tilt, rs_image *out, rs_error *err)
+{
+    rs_splat_cloud *face = NULL;
+    rs_env *env = NULL;
+    rs_renderer *r = NULL;
+    rs_result res = rs_splat_load("assets/face.rsf", &face, err);
+    if (!res) res = rs_env_load("assets/env/daylight.rse", &env, err);
+    uint32_t n = face ? face->hdr.count : 0;
+    uint8_t *ao = malloc(RS_MAX(n, 1u));
+    float(*bent)[3] = malloc(sizeof *bent * RS_MAX(n, 1u));
+    if (!res && (!ao || !bent)) res = rs_fail(err, RS_ERR_NOMEM, "out of memory");
+    if (!res) {
+        memset(ao, 255, n);
+        rs_splat_set_ao(face, ao);
+        for (uint32_t i = 0; i < n; i++) {
+            float *b = bent[i], l = 0;
+            for (int k = 0; k < 3; k++) b[k] = face->normal[i][k] + (k == 1 ? RS_MAX(tilt, 0.0f) : 0.0f), l += b[k] * b[k];
+            for (int k = 0; k < 3; k++) b[k] /= sqrtf(l);
+        }
+        // The same normals either way: set, then (tilt < 0) cleared, which keeps them.
+        rs_splat_set_bent(face, (const float(*)[3])bent);
+        if (tilt < 0) rs_splat_set_bent(face, NULL);
+        res = rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &r, err);
+    }
+    if (!res) res = rs_render_set_env(r, env, err);
+    if (!res) {
+        rs_view v = rs_view_defaults();
+        v.width = v.height = 256;
+        v.max_splats = MAX_SPLATS;
+        res = rs_render_image(r, &v, out, err);
+    }
+    rs_render_destroy(r);
+    rs_env_destroy(env);
+    rs_splat_destroy(face);
+    free(ao);
+    free(bent);
+    return res;
+}
+
+static void test_open_unbent_sky_renders_as_without_bent_normals(void)
+{
+    rs_image none = {0}, same = {0}, up = {0};
+    rs_error err = {0};
+    rs_image_metrics m = {0}, mu = {0};
+    bool ok = RS_CHECK(render_sky(-1.0f, &none, &err) == RS_OK && render_sky(0.0f, &same, &err) == RS_OK &&
+                           render_sky(0.5f, &up, &err) == RS_OK,
+                       "%s", err.msg) &&
+              RS_CHECK(rs_image_compare(&none, &same, 3, &m, &err) == RS_OK &&
+                           rs_image_compare(&none, &up, 3, &mu, &err) == RS_OK,
+                       "%s", err.msg);
+    if (ok) {
+        printf("# open sky: bent = normal vs none max %d; bent turned towards up: PSNR %.1f dB\n", m.max_abs, mu.psnr);
+        RS_CHECK(m.max_abs == 0, "bent normals equal to the normals change the picture (max %d)", m.max_abs);
+        RS_CHECK(mu.psnr < 40.0, "bent normals turned up do not change the light (%.1f dB)", mu.psnr);
+    }
+    rs_image_free(&none);
+    rs_image_free(&same);
+    rs_image_free(&up);
+}
+
 static void test_render_of_quantized_splats_matches_float_data(void)
 {
     rs_error err = {0};
@@ -54,6 +120,7 @@ static void test_render_of_quantized_splats_matches_float_data(void)
     uint32_t seed = 12345;
     for (uint32_t i = 0; i < n; i++) rs_splat_get(face, i, &s[i]);
     rs_splat_header hq = *h;
+    hq.flags &= ~RS_SPLAT_FLAG_BENT;  // float splats carry no bent normals
     hq.lod_count = 1;
     hq.lods[0] = n;
     // The prefix drawn as a whole cloud has coarser spacing: scale radii as the LOD would.
@@ -99,6 +166,7 @@ int main(int argc, char **argv)
         return 1;
     }
     RS_RUN(test_render_of_quantized_splats_matches_float_data);
+    RS_RUN(test_open_unbent_sky_renders_as_without_bent_normals);
     rs_gl_destroy(gl);
     return rs_test_finish();
 }

@@ -209,6 +209,91 @@ static void test_ambient_occlusion_byte_and_flag_survive_v2(void)
     rs_splat_destroy(d);
 }
 
+static double angle_between_deg(const float a[3], const float b[3])
+{
+    double cx = (double)a[1] * b[2] - (double)a[2] * b[1], cy = (double)a[2] * b[0] - (double)a[0] * b[2],
+           cz = (double)a[0] * b[1] - (double)a[1] * b[0];
+    double dot = (double)a[0] * b[0] + (double)a[1] * b[1] + (double)a[2] * b[2];
+    return atan2(sqrt(cx * cx + cy * cy + cz * cz), dot) * 180 / PI;
+}
+
+// Bent normals (RS_SPLAT_FLAG_BENT) in the normal's low bits: a bent normal equal to the normal comes back
+// exactly (open skin keeps its light), bends up to 75 degrees within 3 degrees, every normal within
+// 0.25 degrees of where it was (the 10-bit lattice); through v1 and v2 files; cleared, the normals stay
+// and the flag goes.
+static void test_bent_normals_round_trip_and_survive_files(void)
+{
+    rs_splat_cloud *c = smooth_cloud(40, 21, NULL), *d = NULL;
+    uint32_t n = c->hdr.count;
+    uint8_t *ao = malloc(n);
+    float(*bent)[3] = malloc(sizeof *bent * n), (*before)[3] = malloc(sizeof *before * n);
+    RS_REQUIRE(ao && bent && before, "out of memory");
+    memcpy(before, c->normal, sizeof *before * n);
+    rng_seed(22);
+    for (uint32_t i = 0; i < n; i++) {
+        ao[i] = (uint8_t)(i % 256);
+        // Tilt the normal by up to 75 degrees towards a random direction (every third splat: not at all).
+        const float *m = c->normal[i];
+        float t[3] = {(float)(2 * rng_unit() - 1), (float)(2 * rng_unit() - 1), (float)(2 * rng_unit() - 1)};
+        float dn = t[0] * m[0] + t[1] * m[1] + t[2] * m[2], tl = 0;
+        for (int k = 0; k < 3; k++) t[k] -= dn * m[k], tl += t[k] * t[k];
+        double a = i % 3 ? rng_unit() * 75 * PI / 180 : 0.0;
+        for (int k = 0; k < 3; k++)
+            bent[i][k] = (float)(cos(a) * m[k] + sin(a) * t[k] / sqrt(fmax(tl, 1e-12)));
+    }
+    rs_splat_set_ao(c, ao);
+    rs_splat_set_bent(c, (const float(*)[3])bent);
+    RS_REQUIRE(c->hdr.flags & RS_SPLAT_FLAG_BENT, "rs_splat_set_bent did not set the flag");
+    double worst_bent = 0, worst_normal = 0, worst_same = 0;
+    bool get_agrees = true;
+    for (uint32_t i = 0; i < n; i++) {
+        float b[3];
+        rs_splat_bent(c, i, b);
+        double e = angle_between_deg(b, bent[i]);
+        if (i % 3) worst_bent = fmax(worst_bent, e);
+        else worst_same = fmax(worst_same, angle_between_deg(b, c->normal[i]));
+        worst_normal = fmax(worst_normal, angle_between_deg(before[i], c->normal[i]));
+        rs_splat s;
+        rs_splat_get(c, i, &s);
+        get_agrees &= memcmp(s.normal, c->normal[i], sizeof s.normal) == 0;
+    }
+    printf("# bent normals: worst %.2f deg (bends to 75 deg), %.4f deg where unbent; normals moved %.3f deg\n",
+           worst_bent, worst_same, worst_normal);
+    RS_CHECK(worst_bent < 3.0, "bent normal off by %.2f deg", worst_bent);
+    RS_CHECK(worst_same < 0.01, "an unbent normal comes back %.4f deg off", worst_same);
+    RS_CHECK(worst_normal < 0.25, "normals moved %.3f deg", worst_normal);
+    RS_CHECK(get_agrees, "rs_splat_get's normal is not the cloud's (the bent bits not cleared)");
+    for (int v = 1; v <= 2; v++) {
+        void *data = NULL;
+        size_t len;
+        rs_error err = {0};
+        RS_REQUIRE(rs_splat_save_memory_with(c, &(rs_splat_save_desc){.version = (uint32_t)v}, &data, &len, &err) == RS_OK,
+                   "%s", err.msg);
+        RS_REQUIRE(rs_splat_load_memory(data, len, &d, &err) == RS_OK, "v%d: %s", v, err.msg);
+        bool same = same_cloud(c, d) && (d->hdr.flags & RS_SPLAT_FLAG_BENT);
+        for (uint32_t i = 0; same && i < n; i++) {
+            float a[3], b[3];
+            rs_splat_bent(c, i, a), rs_splat_bent(d, i, b);
+            same = memcmp(a, b, sizeof a) == 0 && memcmp(c->normal[i], d->normal[i], sizeof a) == 0;
+        }
+        RS_CHECK(same, "v%d: bent normals, normals or the flag changed through the file", v);
+        free(data);
+        rs_splat_destroy(d);
+        d = NULL;
+    }
+    memcpy(before, c->normal, sizeof *before * n);
+    rs_splat_set_bent(c, NULL);
+    bool kept = !(c->hdr.flags & RS_SPLAT_FLAG_BENT);
+    for (uint32_t i = 0; i < n; i++) {
+        float b[3];
+        rs_splat_bent(c, i, b);
+        kept &= memcmp(before[i], c->normal[i], sizeof b) == 0 && memcmp(b, c->normal[i], sizeof b) == 0;
+    }
+    RS_CHECK(kept, "clearing the bent normals moved the normals or left the flag");
+    free(ao), free(bent), free(before);
+    rs_splat_destroy(c);
+}
+
 static void test_v1_still_loads_and_can_be_written(void)
 {
     rs_splat_cloud *c = smooth_cloud(20, 4, NULL), *d = NULL, *e = NULL;
@@ -751,6 +836,7 @@ int main(int argc, char **argv)
     RS_RUN(test_codec_carries_every_byte_of_every_record);
     RS_RUN(test_v2_round_trip_is_lossless_and_stable);
     RS_RUN(test_ambient_occlusion_byte_and_flag_survive_v2);
+    RS_RUN(test_bent_normals_round_trip_and_survive_files);
     RS_RUN(test_v1_still_loads_and_can_be_written);
     RS_RUN(test_v2_layout_matches_docs);
     RS_RUN(test_v2_fixtures_load_and_tiny_matches_the_encoder);

@@ -770,6 +770,7 @@ static void test_other_header_fields_are_checked(void)
     field_case cases[] = {
         {8, false, 0, 624, "header_size: 624, expected 608", "(byte 8)"},
         {12, false, 0, 2, "flags: 0x00000002", "(byte 12)"},
+        {12, false, 0, 4, "bent normals without ambient occlusion", "(byte 12)"},
         {52, true, 0.0f, 0, "mm_per_unit: 0", "(byte 52)"},
         {52, true, INFINITY, 0, "mm_per_unit: inf", "(byte 52)"},
         {60, true, NAN, 0, "centre[1]: nan", "(byte 60)"},

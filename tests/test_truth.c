@@ -71,14 +71,18 @@ static const measured was[] = {
     // tools/truth/sss_calibrate.py) at 1024 samples (was 256): rouge unchanged, dE studio 1.40 / 1.76 ->
     // 1.33 / 1.61, daylight 1.22 / 1.38 -> 1.23 / 1.35, office 1.47 / 1.46 -> 1.41 / 1.38, sunset 1.18 /
     // 1.35 -> 1.18 / 1.33 (at 256 samples the calibrated walks' noise added 0.15-0.35 to each).
-    {"studio", "front", 1.33, {1.015, 1.036, 0.970, 1.014, 1.000}, 1.125, 0.26},
-    {"studio", "threequarter", 1.61, {0.996, 1.057, 0.941, 1.021, 0.994}, 0.994, 0.13},
-    {"daylight", "front", 1.23, {0.981, 1.018, 1.010, 1.006, 1.009}, 0.993, 0.12},
-    {"daylight", "threequarter", 1.35, {0.949, 1.015, 0.947, 0.990, 0.991}, 1.005, 0.07},
-    {"office", "front", 1.41, {1.010, 1.037, 1.046, 0.990, 1.015}, 1.060, 0.00},
-    {"office", "threequarter", 1.38, {1.005, 1.050, 1.007, 0.990, 1.007}, 1.062, 0.01},
-    {"sunset", "front", 1.18, {1.045, 1.084, 1.034, 1.036, 1.074}, 1.009, 0.00},
-    {"sunset", "threequarter", 1.33, {1.043, 1.075, 0.974, 1.022, 1.056}, 1.006, 0.00},
+    // The environment's SH light through bent cones (the splats' bent normals, env_light.glsl rs_env_sky;
+    // before: the hemisphere around the normal times the occlusion): dE studio 1.33 / 1.61 -> 1.31 / 1.64,
+    // daylight 1.23 / 1.35 -> 1.15 / 1.16, office 1.41 / 1.38 -> 1.49 / 1.38, sunset 1.18 / 1.33 -> 0.88 /
+    // 0.98; band studio 3/4 0.994 -> 1.002, daylight 0.993 / 1.005 -> 0.997 / 0.999.
+    {"studio", "front", 1.31, {1.019, 1.038, 0.973, 1.014, 1.007}, 1.129, 0.16},
+    {"studio", "threequarter", 1.64, {1.012, 1.054, 0.961, 1.024, 0.999}, 1.002, 0.08},
+    {"daylight", "front", 1.15, {0.995, 1.054, 1.036, 1.018, 1.031}, 0.997, 0.00},
+    {"daylight", "threequarter", 1.16, {0.973, 1.056, 0.993, 1.009, 1.020}, 0.999, 0.00},
+    {"office", "front", 1.49, {1.021, 1.045, 1.056, 1.009, 0.988}, 1.056, 0.00},
+    {"office", "threequarter", 1.38, {0.976, 1.047, 1.017, 0.995, 0.959}, 1.060, 0.01},
+    {"sunset", "front", 0.88, {1.008, 1.061, 1.016, 1.018, 1.026}, 1.014, 0.02},
+    {"sunset", "threequarter", 0.98, {1.012, 1.063, 0.996, 1.010, 1.022}, 1.005, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87

@@ -221,6 +221,18 @@ static int info(const char *path, const char *preview)
         }
         printf("  occlusion     ambient occlusion per splat: mean %.3f, %.1f%% below 0.5\n", sum / h->count,
                100.0 * low / h->count);
+        if (h->flags & RS_SPLAT_FLAG_BENT) {
+            // How far the open sky's axis turns from the normal: the mean angle.
+            double turn = 0;
+            for (uint32_t i = 0; i < h->count; i++) {
+                float b[3], *n = c->normal[i];
+                rs_splat_bent(c, i, b);
+                turn += acos(RS_CLAMP(b[0] * n[0] + b[1] * n[1] + b[2] * n[2], -1.0f, 1.0f));
+            }
+            printf("  bent normals  mean %.1f degrees from the normal\n", turn / h->count * 57.29578);
+        } else {
+            printf("  bent normals  none (environments light a hemisphere around the normal; rouge-pack --ao adds them)\n");
+        }
     } else {
         printf("  occlusion     none (every splat open to the sky; rouge-pack --ao adds it)\n");
     }

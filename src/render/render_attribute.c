@@ -50,8 +50,9 @@ rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
     const rs_splat_header *h = &r->cloud->hdr;
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_attr);
     glViewport(0, 0, cam->width, cam->height);
-    const int targets = 3;
-    const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    const int targets = RS_ATTR_TARGETS;
+    const GLenum bufs[RS_ATTR_TARGETS] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                          GL_COLOR_ATTACHMENT3};
     glDrawBuffers(targets, bufs);
     const GLfloat zero[4] = {0, 0, 0, 0};
     for (int i = 0; i < targets; i++) glClearBufferfv(GL_COLOR, i, zero);

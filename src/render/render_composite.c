@@ -61,7 +61,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform1f(rs_uloc(prog, "u_min_weight"), r->float_rt ? 0.0f : RS_MIN_WEIGHT_RGBA8);
     rs_render_shadow_uniforms(r, f, prog);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
-    for (int i = 0; i < 3; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
+    for (int i = 0; i < RS_ATTR_TARGETS; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
     rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
     rs_render_fine_uniforms(r, f, prog);
     glBindVertexArray(r->vao_empty);

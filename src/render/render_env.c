@@ -370,6 +370,7 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
 {
     bool on = f->env_on;
     glUniform1f(rs_uloc(prog, "u_env_on"), on ? 1.0f : 0.0f);
+    glUniform1f(rs_uloc(prog, "u_env_cones"), (r->cloud->hdr.flags & RS_SPLAT_FLAG_BENT) ? 1.0f : 0.0f);
     rs_render_bind_texture(RS_UNIT_ENV, on ? r->env_tex : 0);
     rs_render_bind_texture(RS_UNIT_SPEC_LUT, on ? r->lut_tex : 0);
     if (!on) return;

@@ -91,11 +91,13 @@ rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *ou
     glUniform1i(rs_uloc(p, "u_attr0"), RS_UNIT_ATTR0);
     glUniform1i(rs_uloc(p, "u_attr1"), RS_UNIT_ATTR1);
     glUniform1i(rs_uloc(p, "u_attr2"), RS_UNIT_ATTR2);
+    glUniform1i(rs_uloc(p, "u_attr3"), RS_UNIT_ATTR3);
     glUniform1i(rs_uloc(p, "u_diffuse"), RS_UNIT_DIFFUSE);
     glUniform1i(rs_uloc(p, "u_level"), RS_UNIT_LEVEL);
     glUniform1i(rs_uloc(p, "u_env_map"), RS_UNIT_ENV);
     glUniform1i(rs_uloc(p, "u_spec_lut"), RS_UNIT_SPEC_LUT);
     glUniform1f(rs_uloc(p, "u_has_ao"), (h->flags & RS_SPLAT_FLAG_AO) ? 1.0f : 0.0f);
+    glUniform1f(rs_uloc(p, "u_has_bent"), (h->flags & RS_SPLAT_FLAG_BENT) ? 1.0f : 0.0f);
     r->prog[kind][q] = p;
     *out = p;
     return RS_OK;

@@ -39,9 +39,10 @@ typedef enum rs_prog {
 enum {
     RS_UNIT_DEPTH = 0,   // visibility depth (u_depth)
     RS_UNIT_SHADOW,      // shadow map (u_shadow_map, compare mode)
-    RS_UNIT_ATTR0,       // attribute targets (u_attr0..2)
+    RS_UNIT_ATTR0,       // attribute targets (u_attr0..3)
     RS_UNIT_ATTR1,
     RS_UNIT_ATTR2,
+    RS_UNIT_ATTR3,
     RS_UNIT_DIFFUSE,     // D (u_diffuse)
     RS_UNIT_LEVEL,       // one diffusion level's accumulation (u_level)
     RS_UNIT_ENV,         // the environment's prefiltered radiance (u_env_map)
@@ -98,6 +99,7 @@ typedef struct rs_render_env {
 
 // Texture formats of the accumulation targets: RGBA16F when the driver renders to half floats, else the
 // documented RGBA8 fallback with pre-scaled sums (render_attribute.c, render_diffusion.c).
+#define RS_ATTR_TARGETS 4  // albedo; normal, m; rho_s and layers; bent normal (attribute.frag.glsl)
 #define RS_ATTR_WEIGHT_SCALE_RGBA8 0.2f
 #define RS_ATTR_WEIGHT_FLOOR_RGBA8 0.15f
 #define RS_MIN_WEIGHT_RGBA8 (5.5f / 255.0f)  // attribute sums below this are rounding noise: holes
@@ -218,7 +220,7 @@ struct rs_renderer {
 
     // Frame targets (width x height).
     int tw, th;
-    GLuint depth_tex, attr_tex[3], diffuse_tex, out_tex;
+    GLuint depth_tex, attr_tex[RS_ATTR_TARGETS], diffuse_tex, out_tex;
     GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_out;
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;

@@ -42,6 +42,53 @@ void rs_splat_decode_normal(uint32_t code, float n[3])
     n[2] = z * inv;
 }
 
+// The bent normal, the low 6 bits of each half of w[2] (RS_SPLAT_FLAG_BENT): the direction it turns
+// away from the normal, along the normal's tangents (Duff et al. 2017's orthonormal basis, the same in
+// splat_decode.glsl), at a radius that grows as (angle / 90 deg)^(2/3), each coordinate a snorm6 (+-31):
+// exact where it is the normal (open skin keeps its normal's light to the bit), ~1.7 degree steps at a
+// 5-degree bend, ~3 at 30, ~4 at 60.
+static void tangents_of(const float n[3], float t1[3], float t2[3])
+{
+    float s = n[2] < 0.0f ? -1.0f : 1.0f, a = -1.0f / (s + n[2]), b = n[0] * n[1] * a;
+    t1[0] = 1.0f + s * n[0] * n[0] * a, t1[1] = s * b, t1[2] = -s * n[0];
+    t2[0] = b, t2[1] = s + n[1] * n[1] * a, t2[2] = -n[1];
+}
+
+static int snorm6_of(uint32_t bits)
+{
+    int s = (int)(bits & 63u);
+    return s >= 32 ? s - 64 : s;
+}
+
+static void decode_bent(uint32_t w2, const float n[3], float out[3])
+{
+    float u = (float)snorm6_of(w2) / 31.0f, v = (float)snorm6_of(w2 >> 16) / 31.0f, rho = sqrtf(u * u + v * v);
+    if (rho == 0.0f) {
+        memcpy(out, n, sizeof(float) * 3);
+        return;
+    }
+    float t1[3], t2[3];
+    tangents_of(n, t1, t2);
+    float r = fminf(rho, 1.0f), angle = r * sqrtf(r) * 1.5707963f, c = cosf(angle), s = sinf(angle) / rho, l = 0.0f;
+    for (int k = 0; k < 3; k++) out[k] = c * n[k] + s * (u * t1[k] + v * t2[k]), l += out[k] * out[k];
+    l = 1.0f / sqrtf(l);
+    for (int k = 0; k < 3; k++) out[k] *= l;
+}
+
+static uint32_t encode_bent(const float b[3], const float n[3])
+{
+    float t1[3], t2[3];
+    tangents_of(n, t1, t2);
+    double x = (double)b[0] * t1[0] + (double)b[1] * t1[1] + (double)b[2] * t1[2];
+    double y = (double)b[0] * t2[0] + (double)b[1] * t2[1] + (double)b[2] * t2[2];
+    double c = (double)b[0] * n[0] + (double)b[1] * n[1] + (double)b[2] * n[2], t = sqrt(x * x + y * y);
+    if (!(t > 0.0) || !isfinite(t) || !isfinite(c)) return 0;
+    // Past the horizon (a splat never sees the sky only behind itself) it lies on the horizon.
+    double angle = fmin(atan2(t, c), 1.5707963267948966), rho = pow(angle / 1.5707963267948966, 2.0 / 3.0);
+    int qu = (int)lround(31.0 * rho * x / t), qv = (int)lround(31.0 * rho * y / t);
+    return (uint32_t)(qu & 63) | (uint32_t)(qv & 63) << 16;
+}
+
 static uint32_t pack_snorm16x2(int u, int v) { return (uint32_t)(u & 0xffff) | (uint32_t)(v & 0xffff) << 16; }
 
 // The unit direction (x, y, z) on the lattice of codes that are multiples of `step` (a power of two),
@@ -97,11 +144,16 @@ static uint32_t encode_normal_lattice(const float n[3], int step)
 void rs_splat_quantize_normals(rs_splat_cloud *c, int bits)
 {
     assert(c && bits >= 8 && bits <= 16);
+    // A bent normal keeps its bits, the normal its coarser lattice under them.
+    bool bent = c->hdr.flags & RS_SPLAT_FLAG_BENT;
+    if (bent) bits = RS_MIN(bits, 10);
     if (bits == 16) return;
     int step = 1 << (16 - bits);
     for (uint32_t i = 0; i < c->hdr.count; i++) {
+        uint32_t keep = bent ? c->packed[i].w[2] & 0x003f003fu : 0u;
         c->packed[i].w[2] = encode_normal_lattice(c->normal[i], step);
         rs_splat_decode_normal(c->packed[i].w[2], c->normal[i]);
+        c->packed[i].w[2] |= keep;
     }
 }
 
@@ -366,8 +418,10 @@ rs_result rs_splat_check_header(const rs_splat_header *h, const char *name, bool
     check_ctx x = {name, in_file, err};
     if (h->count == 0 || h->count > RS_SPLAT_MAX_COUNT)
         return bad(&x, RSF_OFF_COUNT, "count: %u splats, must be 1..%u", h->count, RS_SPLAT_MAX_COUNT);
-    if (h->flags & ~RS_SPLAT_FLAG_AO)
+    if (h->flags & ~(RS_SPLAT_FLAG_AO | RS_SPLAT_FLAG_BENT))
         return bad(&x, RSF_OFF_FLAGS, "flags: 0x%08x, unknown bits must be 0", h->flags);
+    if ((h->flags & RS_SPLAT_FLAG_BENT) && !(h->flags & RS_SPLAT_FLAG_AO))
+        return bad(&x, RSF_OFF_FLAGS, "flags: 0x%08x, bent normals without ambient occlusion", h->flags);
     rs_result r;
     if ((r = check_bbox(&x, h)) != RS_OK) return r;
     if ((r = check_radius(&x, h)) != RS_OK) return r;
@@ -422,6 +476,7 @@ rs_result rs_splat_decode_range(rs_splat_cloud *c, uint32_t first, uint32_t n, r
         st->ready = true;
     }
     const float *lo = st->lo, *step = st->step, *radius_of = st->radius_of;
+    const uint32_t mask = rs_splat_normal_mask(h->flags);
     double area = 0;
     for (uint32_t i = first; i < first + n; i++) {
         const uint32_t *w = c->packed[i].w;
@@ -436,7 +491,7 @@ rs_result rs_splat_decode_range(rs_splat_cloud *c, uint32_t first, uint32_t n, r
         c->pos[i][0] = lo[0] + (float)(w[0] & 0xffffu) * step[0];
         c->pos[i][1] = lo[1] + (float)(w[0] >> 16) * step[1];
         c->pos[i][2] = lo[2] + (float)(w[1] & 0xffffu) * step[2];
-        rs_splat_decode_normal(w[2], c->normal[i]);
+        rs_splat_decode_normal(w[2] & mask, c->normal[i]);
         c->radius[i] = radius_of[(w[1] >> 16) & 0xffu];
         area += (double)c->radius[i] * c->radius[i];
         st->region_counts[region]++;
@@ -491,6 +546,8 @@ static rs_result fill_header(rs_splat_header *h, const rs_splat_header *in, rs_e
     static const rs_splat_header none;
     if (!in) in = &none;
     memset(h, 0, sizeof *h);
+    if (in->flags & RS_SPLAT_FLAG_BENT)
+        return rs_fail(err, RS_ERR_ARG, "%s: flags: RS_SPLAT_FLAG_BENT comes with the bent normals (rs_splat_set_bent)", who);
     if (in->flags & ~RS_SPLAT_FLAG_AO) return rs_fail(err, RS_ERR_ARG, "%s: flags: 0x%08x, unknown bits", who, in->flags);
     if (in->lod_count > RS_SPLAT_MAX_LODS)
         return rs_fail(err, RS_ERR_ARG, "%s: lod_count: %u, at most %d", who, in->lod_count, RS_SPLAT_MAX_LODS);
@@ -660,7 +717,7 @@ void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out)
     const rs_splat_header *h = &c->hdr;
     uint32_t q[3] = {w[0] & 0xffffu, w[0] >> 16, w[1] & 0xffffu};
     for (int a = 0; a < 3; a++) out->pos[a] = decode_unorm16(q[a], h->bbox_min[a], h->bbox_max[a]);
-    rs_splat_decode_normal(w[2], out->normal);
+    rs_splat_decode_normal(w[2] & rs_splat_normal_mask(h->flags), out->normal);
     out->radius = decode_radius(h, (w[1] >> 16) & 0xffu);
     out->rgb[0] = (uint8_t)(w[3] & 0xffu);
     out->rgb[1] = (uint8_t)((w[3] >> 8) & 0xffu);
@@ -679,6 +736,25 @@ void rs_splat_set_ao(rs_splat_cloud *c, const uint8_t *ao)
 float rs_splat_ao(const rs_splat_cloud *c, uint32_t i)
 {
     return (c->hdr.flags & RS_SPLAT_FLAG_AO) ? (float)(c->packed[i].w[3] >> 24) / 255.0f : 1.0f;
+}
+
+void rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3])
+{
+    if (!bent) {
+        for (uint32_t i = 0; i < c->hdr.count; i++) c->packed[i].w[2] &= 0xffc0ffc0u;
+        c->hdr.flags &= ~RS_SPLAT_FLAG_BENT;
+        return;
+    }
+    if (!(c->hdr.flags & RS_SPLAT_FLAG_BENT)) rs_splat_quantize_normals(c, 10);
+    for (uint32_t i = 0; i < c->hdr.count; i++)
+        c->packed[i].w[2] = (c->packed[i].w[2] & 0xffc0ffc0u) | encode_bent(bent[i], c->normal[i]);
+    c->hdr.flags |= RS_SPLAT_FLAG_BENT;
+}
+
+void rs_splat_bent(const rs_splat_cloud *c, uint32_t i, float out[3])
+{
+    if (c->hdr.flags & RS_SPLAT_FLAG_BENT) decode_bent(c->packed[i].w[2], c->normal[i], out);
+    else memcpy(out, c->normal[i], sizeof(float) * 3);
 }
 
 uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count)

@@ -22,6 +22,10 @@
 #define RS_SPLAT_MAX_NOTES 8192         // attribution / provenance text carried from the source scan
 #define RS_SPLAT_MAX_COUNT (64u << 20)  // 64M splats: far above any face scan, keeps sizes in 32 bits
 #define RS_SPLAT_FLAG_AO (1u << 0)      // header flag: byte 15 of every record is its ambient occlusion
+// Header flag (with RS_SPLAT_FLAG_AO only): the low 6 bits of each half of w[2] are the splat's bent normal
+// (below), its normal is the rest (a 10-bit octahedral lattice). Bit 1 is never used: files from before
+// it was defined were rejected with it set, so it stays an error.
+#define RS_SPLAT_FLAG_BENT (1u << 2)
 
 // Built-in region ids. Every file carries the first five (rs_splat_default_regions); rouge-pack adds
 // eyelid and brow; a table may add more after these. Brushes find regions by name.
@@ -49,7 +53,10 @@ typedef struct rs_splat {
 // The 16-byte record stored in the file and in the GPU buffer (read in shaders as one uvec4):
 //   w[0] = x16 | y16 << 16                      position, unorm16 over the bounding box
 //   w[1] = z16 | radius8 << 16 | region8 << 24  radius log-quantized over [radius_min, radius_max]
-//   w[2] = oct_u16 | oct_v16 << 16              normal, octahedral, snorm16 (max error ~0.003 deg)
+//   w[2] = oct_u16 | oct_v16 << 16              normal, octahedral, snorm16 (max error ~0.003 deg); with
+//          RS_SPLAT_FLAG_BENT each half's low 6 bits are the bent normal (the mean open direction) as a
+//          turn away from the normal along its two tangents (splat.c), and the normal the code with them
+//          cleared (a 10-bit lattice, ~0.2 deg)
 //   w[3] = r8 | g8 << 8 | b8 << 16 | ao8 << 24      sRGB colour; ambient occlusion (0 without RS_SPLAT_FLAG_AO)
 typedef struct rs_splat_packed {
     uint32_t w[4];
@@ -175,6 +182,13 @@ void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out);
 // or removes it (NULL); reads it (1 when the cloud has none).
 void rs_splat_set_ao(rs_splat_cloud *c, const uint8_t *ao);
 float rs_splat_ao(const rs_splat_cloud *c, uint32_t i);
+// Per-splat bent normal (RS_SPLAT_FLAG_BENT): the cosine-weighted mean of the directions a splat sees the
+// sky in, unit, model space; with the occlusion it makes a cone of visible sky that environments light
+// (bent cones). Setting it (bent[count], unit vectors; the cloud must have ambient occlusion) moves every
+// normal onto the 10-bit lattice the bits leave; NULL removes it (the normals stay where they are).
+// Reading gives the normal when the cloud has none.
+void rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3]);
+void rs_splat_bent(const rs_splat_cloud *c, uint32_t i, float out[3]);
 // Largest LOD prefix from the table with at most max_count splats (the smallest level if none fits).
 uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count);
 // Radius multiplier for drawing only the first n splats: sqrt(count / n).
@@ -193,9 +207,14 @@ void rs_splat_quantize_normals(rs_splat_cloud *c, int bits);
 // file. The radius array follows the records.
 void rs_splat_quantize_radii(rs_splat_cloud *c, int bits);
 
-// Octahedral normal coding, exposed for tests and shaders' CPU mirror.
+// Octahedral normal coding, exposed for tests and shaders' CPU mirror. A record's normal is decoded from
+// w[2] & rs_splat_normal_mask(flags) (the bent normal's bits cleared).
 uint32_t rs_splat_encode_normal(const float n[3]);
 void rs_splat_decode_normal(uint32_t code, float n[3]);
+static inline uint32_t rs_splat_normal_mask(uint32_t flags)
+{
+    return (flags & RS_SPLAT_FLAG_BENT) ? 0xffc0ffc0u : 0xffffffffu;
+}
 
 uint32_t rs_crc32(uint32_t crc, const void *data, size_t len);
 

@@ -35,7 +35,8 @@
 #define RS_PACK_FACE_SAMPLE_PER_TRIANGLE 16u
 #define RS_PACK_FACE_SAMPLE_MIN 2000u
 // Normals are stored on a 12-bit octahedral lattice (at most 0.05 degrees from the 16-bit code; a scan's
-// normal map resolves ~0.5 degrees): 2 bytes a splat less in a v2 .rsf (rs_splat_quantize_normals).
+// normal map resolves ~0.5 degrees): 2 bytes a splat less in a v2 .rsf (rs_splat_quantize_normals); 10
+// bits (~0.2 degrees) with the occlusion, whose bent normal takes the low bits.
 #define RS_PACK_NORMAL_BITS 12
 // Radius codes on a 6-bit lattice (multiples of 4 of the 8-bit log code: 1.3 % steps for the bundled
 // head, whose radii, the 8th-neighbour distance, spread over 0.6..1.4 mm from splat to splat with no
@@ -309,14 +310,17 @@ typedef struct rs_pack_report {
 } rs_pack_report;
 
 // Ambient occlusion per splat (pack_ao.c): the cosine-weighted fraction of RS_PACK_AO_DIRS directions over
-// the sphere from which nothing of the cloud hides the splat, q/255. A few seconds for 600k splats.
+// the sphere from which nothing of the cloud hides the splat, q/255, and (bent, may be NULL) the unit
+// cosine-weighted mean of those open directions (the normal where none is open). A few seconds for 600k
+// splats.
 #define RS_PACK_AO_DIRS 96
-rs_result rs_pack_ao(const rs_splat *splats, uint32_t n, uint8_t *ao, rs_error *err);
+rs_result rs_pack_ao(const rs_splat *splats, uint32_t n, uint8_t *ao, float (*bent)[3], rs_error *err);
 // The same with only splats[0..occluders) drawn as occluders, their radii scaled by sqrt(n / occluders)
 // (an LOD prefix: an even subsample covering the same surface); every splat is tested.
-rs_result rs_pack_ao_prefix(const rs_splat *splats, uint32_t n, uint32_t occluders, uint8_t *ao, rs_error *err);
-// The same for a cloud's splats as the file stores them (quantised), set into it (RS_SPLAT_FLAG_AO):
-// converting and `rouge-pack --ao` on the result give the same bytes.
+rs_result rs_pack_ao_prefix(const rs_splat *splats, uint32_t n, uint32_t occluders, uint8_t *ao, float (*bent)[3],
+                            rs_error *err);
+// The same for a cloud's splats as the file stores them (quantised), set into it (RS_SPLAT_FLAG_AO and
+// RS_SPLAT_FLAG_BENT): converting and `rouge-pack --ao` on the result give the same bytes.
 rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err);
 
 // Converts a loaded PLY into a cloud ready for rs_splat_save. `report` may be NULL.

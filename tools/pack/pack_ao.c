@@ -3,7 +3,11 @@
 // not lit by the environment like the cheek. Computed from software orthographic depth maps of the cloud
 // from RS_PACK_AO_DIRS directions spread over the sphere (a Fibonacci spiral): a splat sees direction d
 // when nothing of the cloud lies in front of it seen from d. The renderer multiplies the environment's SH
-// irradiance and its specular by it (byte 15 of the record, RS_SPLAT_FLAG_AO).
+// irradiance and its specular by it (byte 15 of the record, RS_SPLAT_FLAG_AO). The same maps give each
+// splat's bent normal, the cosine-weighted mean of its open directions (RS_SPLAT_FLAG_BENT): the axis of
+// the cone of sky it sees, which the renderer lights instead of a hemisphere around the normal (a nostril's
+// roof faces up but sees the ground through the opening; the jaw's underside faces down but sees the
+// horizon).
 #define _POSIX_C_SOURCE 200809L  // sysconf
 #include "pack/pack.h"
 
@@ -98,6 +102,7 @@ typedef struct ao_job {
     int map;               // depth map side, texels
     int first, step;       // directions first, first + step, ...
     uint32_t *open, *total;
+    int32_t (*bent)[3];    // sums of the open directions times their cosine, AO_ONE fixed point (or NULL)
     bool failed;
 } ao_job;
 
@@ -128,7 +133,11 @@ static void *ao_worker(void *arg)
             float bias = s->r * j->occluder_scale + j->texel * (1.0f + slope);
             uint32_t q = (uint32_t)lrintf(fminf(nd, 1.0f) * AO_ONE);
             j->total[i] += q;
-            if (dot3(p, o.d) >= depth[y * map + x] - bias) j->open[i] += q;
+            if (dot3(p, o.d) >= depth[y * map + x] - bias) {
+                j->open[i] += q;
+                if (j->bent)
+                    for (int a = 0; a < 3; a++) j->bent[i][a] += (int32_t)lrintf(nd * o.d[a] * AO_ONE);
+            }
         }
     }
     free(depth);
@@ -166,7 +175,8 @@ static int cmp_float(const void *a, const void *b)
 // (neighbouring disks on a curved surface, or tilted by the normal map, stand a little proud of each
 // other) plus a texel scaled by the slope towards d (the texel's centre is up to a texel from the splat's).
 // Directions are shared out over up to AO_MAX_THREADS threads (the cores online).
-rs_result rs_pack_ao_prefix(const rs_splat *s, uint32_t n, uint32_t occluders, uint8_t *ao, rs_error *err)
+rs_result rs_pack_ao_prefix(const rs_splat *s, uint32_t n, uint32_t occluders, uint8_t *ao, float (*bent)[3],
+                            rs_error *err)
 {
     if (n == 0) return RS_OK;
     if (occluders == 0 || occluders > n) occluders = n;
@@ -242,7 +252,8 @@ rs_result rs_pack_ao_prefix(const rs_splat *s, uint32_t n, uint32_t occluders, u
         jobs[t].first = t, jobs[t].step = threads;
         jobs[t].open = calloc(n, sizeof(uint32_t));
         jobs[t].total = calloc(n, sizeof(uint32_t));
-        if (!jobs[t].open || !jobs[t].total) r = RS_ERR_NOMEM;
+        jobs[t].bent = bent ? calloc(n, sizeof *jobs[t].bent) : NULL;
+        if (!jobs[t].open || !jobs[t].total || (bent && !jobs[t].bent)) r = RS_ERR_NOMEM;
     }
     // Thread 0 is this one; a thread that cannot start leaves its directions to be done here afterwards.
     for (int t = 1; t < threads && r == RS_OK; t++) started[t] = pthread_create(&tid[t], NULL, ao_worker, &jobs[t]) == 0;
@@ -259,16 +270,23 @@ rs_result rs_pack_ao_prefix(const rs_splat *s, uint32_t n, uint32_t occluders, u
             for (int t = 0; t < threads; t++) open += jobs[t].open[i], total += jobs[t].total[i];
             float a = total > 0 ? (float)((double)open / (double)total) : 1.0f;
             ao[where[i]] = (uint8_t)lrintf(RS_CLAMP(a, 0.0f, 1.0f) * 255.0f);
+            if (!bent) continue;
+            // A splat that sees no sky keeps its normal (nothing to bend towards).
+            double b[3] = {0, 0, 0};
+            for (int t = 0; t < threads; t++)
+                for (int k = 0; k < 3; k++) b[k] += jobs[t].bent[i][k];
+            double l = sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+            for (int k = 0; k < 3; k++) bent[where[i]][k] = l > 0.0 ? (float)(b[k] / l) : pts[i].n[k];
         }
-    for (int t = 0; t < threads; t++) free(jobs[t].open), free(jobs[t].total);
+    for (int t = 0; t < threads; t++) free(jobs[t].open), free(jobs[t].total), free(jobs[t].bent);
     free(pts), free(occ), free(where);
     if (r != RS_OK) return rs_fail(err, RS_ERR_NOMEM, "ambient occlusion: out of memory");
     return RS_OK;
 }
 
-rs_result rs_pack_ao(const rs_splat *s, uint32_t n, uint8_t *ao, rs_error *err)
+rs_result rs_pack_ao(const rs_splat *s, uint32_t n, uint8_t *ao, float (*bent)[3], rs_error *err)
 {
-    return rs_pack_ao_prefix(s, n, n, ao, err);
+    return rs_pack_ao_prefix(s, n, n, ao, bent, err);
 }
 
 rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err)
@@ -276,7 +294,11 @@ rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err)
     uint32_t n = c->hdr.count;
     rs_splat *s = malloc(sizeof *s * (size_t)RS_MAX(n, 1u));
     uint8_t *ao = malloc(RS_MAX(n, 1u));
-    rs_result r = s && ao ? RS_OK : rs_fail(err, RS_ERR_NOMEM, "ambient occlusion: out of memory");
+    float(*bent)[3] = malloc(sizeof *bent * (size_t)RS_MAX(n, 1u));
+    rs_result r = s && ao && bent ? RS_OK : rs_fail(err, RS_ERR_NOMEM, "ambient occlusion: out of memory");
+    // The normals on the lattice the bent normal leaves them first, so that the occlusion is computed from
+    // the normals the file will hold: recomputing it from the result gives the same bytes.
+    if (r == RS_OK) rs_splat_quantize_normals(c, 10);
     for (uint32_t i = 0; r == RS_OK && i < n; i++) rs_splat_get(c, i, &s[i]);
     // Occluders: the smallest LOD prefix of at least AO_MIN_OCCLUDERS splats (every prefix is an even
     // subsample), drawn with radii scaled to cover the same surface: the depth maps cost a fraction, and
@@ -284,9 +306,10 @@ rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err)
     uint32_t occluders = n;
     for (uint32_t l = 0; l < c->hdr.lod_count; l++)
         if (c->hdr.lods[l] >= AO_MIN_OCCLUDERS && c->hdr.lods[l] < occluders) occluders = c->hdr.lods[l];
-    if (r == RS_OK) r = rs_pack_ao_prefix(s, n, occluders, ao, err);
-    if (r == RS_OK) rs_splat_set_ao(c, ao);
+    if (r == RS_OK) r = rs_pack_ao_prefix(s, n, occluders, ao, bent, err);
+    if (r == RS_OK) rs_splat_set_ao(c, ao), rs_splat_set_bent(c, (const float(*)[3])bent);
     free(s);
     free(ao);
+    free(bent);
     return r;
 }
