@@ -50,7 +50,8 @@ rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
     const rs_splat_header *h = &r->cloud->hdr;
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_attr);
     glViewport(0, 0, cam->width, cam->height);
-    const int targets = RS_ATTR_TARGETS;
+    // The bent normals only light an environment: without one their target is not written.
+    const int targets = f->env_on ? RS_ATTR_TARGETS : RS_ATTR_TARGETS - 1;
     const GLenum bufs[RS_ATTR_TARGETS] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                                           GL_COLOR_ATTACHMENT3};
     glDrawBuffers(targets, bufs);
