@@ -336,7 +336,7 @@ void main()
         alpha = coverage(px);
         t1 = texelFetch(u_attr1, px, 0);
         t2 = texelFetch(u_attr2, px, 0);
-        t3 = texelFetch(u_attr3, px, 0);
+        t3 = u_env_on > 0.5 ? texelFetch(u_attr3, px, 0) : vec4(0.0);  // written under an environment only
         D = texelFetch(u_diffuse, px, 0);
     } else if (!fill_hole(px, t0, t1, t2, t3, p, D)) {
         o_color = vec4(u_background, 1.0);
@@ -387,7 +387,9 @@ void main()
             float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
-            E += rs_env_sky(N, normalize(t3.xyz * inv * 2.0 - 1.0), ao) + rs_env_lamp_irradiance(N, vis);
+            // The bent normal's target has its own weights (RGBA8); where they rounded away, the normal.
+            vec3 B = t3.a > 0.5 / 255.0 ? normalize(t3.rgb / t3.a * 2.0 - 1.0) : N;
+            E += rs_env_sky(N, B, ao) + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
             Eb = rs_bounce(ao, A);

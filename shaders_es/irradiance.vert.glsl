@@ -1,12 +1,12 @@
 #version 300 es
 // irradiance.vert.glsl — stage 4's per-splat input, computed once per frame by transform feedback (no
 // rasterisation) so the diffusion levels don't repeat the shadow-map PCF: each splat's irradiance
-// E = key (N.L, shadow-mapped) + fill (N.L) + ambient + the environment's SH irradiance times the splat's
-// ambient occlusion (so stage 4 scatters environment light like the key light) + its other lamps (N.L,
-// shadow-mapped) + the light the skin around
+// E = key (N.L, shadow-mapped) + fill (N.L) + ambient + the environment's SH irradiance through the splat's
+// bent cone (its bent normal and ambient occlusion, env_light.glsl rs_env_sky: so stage 4 scatters
+// environment light like the key light) + its other lamps (N.L, shadow-mapped) + the light the skin around
 // it bounces into what the occlusion hides (bounce.glsl; the splat's own scanned albedo stands for its
-// surroundings', never the makeup's), and how far it lies behind the visible surface when
-// it faces away (the back of the head: the levels skip it when that exceeds their kernel's reach).
+// surroundings', never the makeup's), and how far it lies behind the visible surface when it faces away
+// (the back of the head: the levels skip it when that exceeds their kernel's reach).
 precision highp float;
 precision highp int;
 #include "splat_decode.glsl"
@@ -71,8 +71,8 @@ void main()
     if (dot(e, e) > 0.0 && !unseen) e *= rs_shadow(c, n);
     e += u_fill_color * max(dot(n, u_fill_dir), 0.0) + u_ambient;
     if (u_env_on > 0.5)
-        e += rs_env_sky(n, mat3(u_view) * s.bent, s.ao) + rs_env_lamp_irradiance(n, unseen ? vec3(1.0) : rs_env_lamp_visibility(c, n))
-           + rs_bounce(s.ao, s.albedo);
+        e += rs_env_sky(n, mat3(u_view) * s.bent, s.ao)
+           + rs_env_lamp_irradiance(n, unseen ? vec3(1.0) : rs_env_lamp_visibility(c, n)) + rs_bounce(s.ao, s.albedo);
     v_irradiance = vec4(e, behind);
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);
     gl_PointSize = 1.0;
