@@ -31,7 +31,8 @@ flat out vec3 v_albedo;
 flat out vec2 v_spec;    // m, rho_s
 flat out vec3 v_layers;  // ambient occlusion, clear-coat weight, flake weight
 flat out vec3 v_debug;
-flat out vec3 v_bent;    // view space
+flat out vec3 v_bent;    // view space; under an environment only (RT3)
+uniform float u_env_on;
 
 // The coarsest LOD level whose prefix holds splat i (the table descends: lods[0] = all splats).
 int lod_level(uint i)
@@ -59,7 +60,7 @@ void main()
     if (u_makeup_on > 0.5) rs_makeup_apply(a_makeup, albedo, m, rho_s, coat, shimmer);
     v_c = c;
     v_n = n;
-    v_bent = mat3(u_view) * s.bent;
+    v_bent = u_env_on > 0.5 ? mat3(u_view) * rs_decode_bent(a_splat, s.normal) : n;
     v_r = s.radius * u_radius_scale;
     v_albedo = albedo;
     v_spec = vec2(m, rho_s);

@@ -71,7 +71,7 @@ void main()
     if (dot(e, e) > 0.0 && !unseen) e *= rs_shadow(c, n);
     e += u_fill_color * max(dot(n, u_fill_dir), 0.0) + u_ambient;
     if (u_env_on > 0.5)
-        e += rs_env_sky(n, mat3(u_view) * s.bent, s.ao)
+        e += rs_env_sky(n, mat3(u_view) * rs_decode_bent(a_splat, s.normal), s.ao)
            + rs_env_lamp_irradiance(n, unseen ? vec3(1.0) : rs_env_lamp_visibility(c, n)) + rs_bounce(s.ao, s.albedo);
     v_irradiance = vec4(e, behind);
     gl_Position = vec4(0.0, 0.0, 0.0, 1.0);

@@ -13,7 +13,6 @@ struct rs_splat {
     vec3 albedo;    // linear RGB
     uint region;
     float ao;       // ambient occlusion, 1 = open sky (1 when the file has none)
-    vec3 bent;      // unit, the axis of the sky it sees (the normal when the file has none)
 };
 
 float rs_snorm16(uint bits)
@@ -34,10 +33,14 @@ vec3 rs_decode_normal(uint code)
     return normalize(vec3(e, z));
 }
 
-// The bent normal: a turn away from n along its tangents (rs_splat_bent, splat.c: Duff et al. 2017's
-// basis), by 90 deg x rho^1.5 for the snorm6 pair's length rho.
-vec3 rs_decode_bent(uint code, vec3 n)
+// The bent normal of record w whose normal is n, unit, the axis of the sky it sees (n when the file has
+// none): a turn away from n along its tangents (rs_splat_bent, splat.c: Duff et al. 2017's basis), by
+// 90 deg x rho^1.5 for the snorm6 pair's length rho. Apart from rs_decode_splat: only environment light
+// needs it.
+vec3 rs_decode_bent(uvec4 w, vec3 n)
 {
+    if (u_has_bent < 0.5) return n;
+    uint code = w.z;
     ivec2 q = ivec2(int(code & 63u), int((code >> 16) & 63u));
     q -= 64 * ivec2(greaterThanEqual(q, ivec2(32)));
     vec2 x = vec2(q) / 31.0;
@@ -61,9 +64,7 @@ rs_splat rs_decode_splat(uvec4 w)
     s.radius = u_radius_log.x * exp(u_radius_log.y * float((w.y >> 16) & 0xffu));
     s.region = w.y >> 24;
     s.ao = u_has_ao > 0.5 ? float(w.w >> 24) / 255.0 : 1.0;
-    bool bent = u_has_bent > 0.5;
-    s.normal = rs_decode_normal(bent ? w.z & 0xffc0ffc0u : w.z);
-    s.bent = bent ? rs_decode_bent(w.z, s.normal) : s.normal;
+    s.normal = rs_decode_normal(u_has_bent > 0.5 ? w.z & 0xffc0ffc0u : w.z);
     s.albedo = rs_srgb_to_linear(vec3(float(w.w & 0xffu), float((w.w >> 8) & 0xffu),
                                       float((w.w >> 16) & 0xffu)) / 255.0);
     return s;
