@@ -405,7 +405,7 @@ static void rsf_rows(bench *b, const char *ply)
         if (!c.ran || c.status != 0 || bytes <= 0) {
             add_row(b, "file bytes/splat: rouge-pack 600k scan", NULL, "n/a (rouge-pack failed: exit %d)", c.status);
         } else {
-            snprintf(notes, sizeof notes, ".rsf v2 as rouge-pack writes it (12-bit normals, 6-bit radii, AO, zstd level 17); "
+            snprintf(notes, sizeof notes, ".rsf v2 as rouge-pack writes it (10-bit normals with bent normals, 6-bit radii, AO, zstd level 17); "
                      "version 1: 16 B; goal <= 8 B (issue 14)");
             add_row(b, "file bytes/splat: rouge-pack 600k scan (.rsf v2)", notes, "%.2f B (%lld B)",
                     (double)bytes / 600000.0, bytes);
@@ -775,7 +775,7 @@ static void env_row(bench *b, rs_gl_context *gl)
     if (ok) {
         double e = bench_median(ms[0], frames), p = bench_median(ms[1], frames);
         char notes[200];
-        snprintf(notes, sizeof notes, "environment `%s` (SH x AO into stage 4, prefiltered specular, coat) vs "
+        snprintf(notes, sizeof notes, "environment `%s` (SH through bent cones into stage 4, prefiltered specular, coat) vs "
                  "`paper` (one lamp); goal (issue 12): <= ~15%% more; median of %d", RS_ENV_DEFAULT, frames);
         add_row(b, what, notes, "%.1f ms vs %.1f ms (%+.0f%%)", e, p, (e / p - 1.0) * 100.0);
     } else {
@@ -1069,9 +1069,11 @@ static void web_rows(bench *b)
         }
         total += z, raw += file_size(file);
     }
-    add_row(b, "web: page weight (gzip -9)", "rouge_core.wasm + .js, rouge.js, app.js, index.html, style.css; besides "
-            "the face (5.4 MB) and environments; goal <= 400 KB", "%.0f KB (%.0f KB uncompressed)", total / 1024.0,
-            raw / 1024.0);
+    char face[512], notes[256];
+    snprintf(face, sizeof face, "%s/web/face.rsf", b->build);
+    snprintf(notes, sizeof notes, "rouge_core.wasm + .js, rouge.js, app.js, index.html, style.css; besides the face "
+             "(%.1f MB) and environments; goal <= 400 KB", (double)file_size(face) / 1048576.0);
+    add_row(b, "web: page weight (gzip -9)", notes, "%.0f KB (%.0f KB uncompressed)", total / 1024.0, raw / 1024.0);
 }
 
 // ---- main ----
