@@ -4,8 +4,9 @@
 // no writes) against the visibility pass, so only the front surface layer accumulates.
 //   RT0 = (albedo, 1) w      RT1 = (normal * 0.5 + 0.5, m) w
 //   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w, or (rho_s, debug colour) w in the debug views
-//   RT3 = (bent normal * 0.5 + 0.5, 1) w (the axis of the sky the surface sees; env_light.glsl rs_env_sky),
-//         always RGBA8, with its own weight sum (u_bent_scale keeps it below 1 over float targets too)
+//   RT3 = (the bent normal's components along the normal's tangents (tangent_basis.glsl), 0, 0) w: the axis
+//         of the sky the surface sees (env_light.glsl rs_env_sky), RG16F (RG8 offset to 0..1 in the
+//         fallback); 0 where it is the normal, so open skin's pixel gets exactly its normal back
 // Normals are stored offset to 0..1 so the RGBA8 fallback needs no signed format; u_weight_scale keeps the
 // fallback's sums below 1 (it cancels in the division) and u_weight_floor keeps a disk's rim from
 // rounding to nothing where it alone covers a pixel (next to occluding edges).
@@ -18,7 +19,7 @@ uniform float u_coverage;  // disks are drawn out to this many radii (render_kit
 uniform float u_inv_two_sigma2;   // 1 / (2 sigma^2), sigma in disk radii
 uniform float u_weight_scale;
 uniform float u_weight_floor;     // RGBA8 fallback: rims count enough to survive 8-bit rounding
-uniform float u_bent_scale;       // RT3's weights relative to w
+uniform vec2 u_bent_code;         // RT3 = (bent * x + y) w: (1, 0), or (0.5, 0.5) in the RGBA8 fallback
 
 flat in vec3 v_c;
 flat in vec3 v_n;
@@ -27,7 +28,7 @@ flat in vec3 v_albedo;
 flat in vec2 v_spec;
 flat in vec3 v_debug;
 flat in vec3 v_layers;
-flat in vec3 v_bent;
+flat in vec2 v_bent;
 uniform int u_debug;
 
 layout(location = 0) out vec4 o_albedo;
@@ -46,5 +47,5 @@ void main()
     o_albedo = vec4(v_albedo, 1.0) * w;
     o_normal = vec4(v_n * 0.5 + 0.5, v_spec.x) * w;
     o_extra = vec4(v_spec.y, u_debug != 0 ? v_debug : v_layers) * w;
-    o_bent = vec4(v_bent * 0.5 + 0.5, 1.0) * (w * u_bent_scale);
+    o_bent = vec4((v_bent * u_bent_code.x + u_bent_code.y) * w, 0.0, 0.0);
 }

@@ -31,7 +31,7 @@ flat out vec3 v_albedo;
 flat out vec2 v_spec;    // m, rho_s
 flat out vec3 v_layers;  // ambient occlusion, clear-coat weight, flake weight
 flat out vec3 v_debug;
-flat out vec3 v_bent;    // view space; under an environment only (RT3)
+flat out vec2 v_bent;    // the bent normal along the view-space normal's tangents; environments only (RT3)
 uniform float u_env_on;
 
 // The coarsest LOD level whose prefix holds splat i (the table descends: lods[0] = all splats).
@@ -60,7 +60,12 @@ void main()
     if (u_makeup_on > 0.5) rs_makeup_apply(a_makeup, albedo, m, rho_s, coat, shimmer);
     v_c = c;
     v_n = n;
-    v_bent = u_env_on > 0.5 ? mat3(u_view) * rs_decode_bent(a_splat, s.normal) : n;
+    v_bent = vec2(0.0);
+    if (u_env_on > 0.5) {
+        vec3 b = mat3(u_view) * rs_decode_bent(a_splat, s.normal), t1, t2;
+        rs_tangents(n, t1, t2);
+        v_bent = vec2(dot(b, t1), dot(b, t2));
+    }
     v_r = s.radius * u_radius_scale;
     v_albedo = albedo;
     v_spec = vec2(m, rho_s);

@@ -15,6 +15,7 @@ precision highp int;
 #include "skin_brdf.glsl"
 #include "env_light.glsl"
 #include "bounce.glsl"
+#include "tangent_basis.glsl"
 #include "makeup_fine.glsl"
 
 // Same numbering as rs_render_mode in render.h.
@@ -32,6 +33,7 @@ uniform highp sampler2D u_attr0;
 uniform highp sampler2D u_attr1;
 uniform highp sampler2D u_attr2;
 uniform highp sampler2D u_attr3;
+uniform vec2 u_bent_code;       // RT3's code (attribute.frag.glsl)
 uniform highp sampler2D u_diffuse;
 uniform int u_mode;
 uniform int u_physical;         // 1: F = A D + S
@@ -387,8 +389,10 @@ void main()
             float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
-            // The bent normal's target has its own weights (RGBA8); where they rounded away, the normal.
-            vec3 B = t3.a > 0.5 / 255.0 ? normalize(t3.rgb / t3.a * 2.0 - 1.0) : N;
+            vec2 bt = (t3.xy * inv - u_bent_code.y) / u_bent_code.x;
+            vec3 t1, t2;
+            rs_tangents(N, t1, t2);
+            vec3 B = normalize(sqrt(max(1.0 - dot(bt, bt), 0.0)) * N + bt.x * t1 + bt.y * t2);
             E += rs_env_sky(N, B, ao) + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.

@@ -1,5 +1,7 @@
 // splat_decode.glsl — the 16-byte splat record (src/splat/splat.h, docs/rsf.md) decoded exactly as
 // rs_splat_get does on the CPU, so picking, brushes and pixels agree.
+#include "tangent_basis.glsl"
+
 uniform vec3 u_bbox_min;      // quantization frame, model units
 uniform vec3 u_bbox_step;     // (bbox_max - bbox_min) / 65535
 uniform vec2 u_radius_log;    // radius = u_radius_log.x * exp(u_radius_log.y * q), q = 0..255
@@ -46,8 +48,8 @@ vec3 rs_decode_bent(uvec4 w, vec3 n)
     vec2 x = vec2(q) / 31.0;
     float rho = length(x);
     if (rho == 0.0) return n;
-    float sg = n.z < 0.0 ? -1.0 : 1.0, a = -1.0 / (sg + n.z), b = n.x * n.y * a;
-    vec3 t1 = vec3(1.0 + sg * n.x * n.x * a, sg * b, -sg * n.x), t2 = vec3(b, sg + n.y * n.y * a, -n.y);
+    vec3 t1, t2;
+    rs_tangents(n, t1, t2);
     float r = min(rho, 1.0), angle = r * sqrt(r) * 1.5707963;
     return normalize(cos(angle) * n + (sin(angle) / rho) * (x.x * t1 + x.y * t2));
 }
