@@ -4,9 +4,12 @@
 // no writes) against the visibility pass, so only the front surface layer accumulates.
 //   RT0 = (albedo, 1) w      RT1 = (normal * 0.5 + 0.5, m) w
 //   RT2 = (rho_s, ambient occlusion, clear coat, flakes) w, or (rho_s, debug colour) w in the debug views
-//   RT3 = (the bent normal's components along the normal's tangents (tangent_basis.glsl), 0, 0) w: the axis
-//         of the sky the surface sees (env_light.glsl rs_env_sky), RG16F (RG8 offset to 0..1 in the
-//         fallback); 0 where it is the normal, so open skin's pixel gets exactly its normal back
+//   RT3 = (u+, u-, v+, v-) w: the bent normal's components (u, v) along the normal's tangents
+//         (tangent_basis.glsl), each split into its positive and negative part: the axis of the sky the
+//         surface sees (env_light.glsl rs_env_sky). Always RGBA8 (half-float blending costs llvmpipe two
+//         to four times as much), its weights RT0's times u_bent_scale (sums below 1); 0 where the bent
+//         normal is the normal, so open skin's pixel gets exactly its normal back, and a pixel whose
+//         weights are too small for 8 bits gets its normal too
 // Normals are stored offset to 0..1 so the RGBA8 fallback needs no signed format; u_weight_scale keeps the
 // fallback's sums below 1 (it cancels in the division) and u_weight_floor keeps a disk's rim from
 // rounding to nothing where it alone covers a pixel (next to occluding edges).
@@ -19,7 +22,7 @@ uniform float u_coverage;  // disks are drawn out to this many radii (render_kit
 uniform float u_inv_two_sigma2;   // 1 / (2 sigma^2), sigma in disk radii
 uniform float u_weight_scale;
 uniform float u_weight_floor;     // RGBA8 fallback: rims count enough to survive 8-bit rounding
-uniform vec2 u_bent_code;         // RT3 = (bent * x + y) w: (1, 0), or (0.5, 0.5) in the RGBA8 fallback
+uniform float u_bent_scale;       // RT3's weights relative to w
 
 flat in vec3 v_c;
 flat in vec3 v_n;
@@ -47,5 +50,5 @@ void main()
     o_albedo = vec4(v_albedo, 1.0) * w;
     o_normal = vec4(v_n * 0.5 + 0.5, v_spec.x) * w;
     o_extra = vec4(v_spec.y, u_debug != 0 ? v_debug : v_layers) * w;
-    o_bent = vec4((v_bent * u_bent_code.x + u_bent_code.y) * w, 0.0, 0.0);
+    o_bent = vec4(max(v_bent, 0.0), max(-v_bent, 0.0)).xzyw * (w * u_bent_scale);
 }

@@ -33,7 +33,7 @@ uniform highp sampler2D u_attr0;
 uniform highp sampler2D u_attr1;
 uniform highp sampler2D u_attr2;
 uniform highp sampler2D u_attr3;
-uniform vec2 u_bent_code;       // RT3's code (attribute.frag.glsl)
+uniform float u_bent_scale;     // RT3's weights relative to RT0's (attribute.frag.glsl)
 uniform highp sampler2D u_diffuse;
 uniform int u_mode;
 uniform int u_physical;         // 1: F = A D + S
@@ -389,7 +389,7 @@ void main()
             float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
-            vec2 bt = (t3.xy * inv - u_bent_code.y) / u_bent_code.x;
+            vec2 bt = vec2(t3.x - t3.y, t3.z - t3.w) * (inv / u_bent_scale);
             vec3 t1, t2;
             rs_tangents(N, t1, t2);
             vec3 B = normalize(sqrt(max(1.0 - dot(bt, bt), 0.0)) * N + bt.x * t1 + bt.y * t2);

@@ -74,15 +74,17 @@ static const measured was[] = {
     // The environment's SH light through bent cones (the splats' bent normals, env_light.glsl rs_env_sky;
     // before: the hemisphere around the normal times the occlusion): dE studio 1.33 / 1.61 -> 1.31 / 1.64,
     // daylight 1.23 / 1.35 -> 1.15 / 1.16, office 1.41 / 1.38 -> 1.49 / 1.38, sunset 1.18 / 1.33 -> 0.88 /
-    // 0.98; band studio 3/4 0.994 -> 1.002, daylight 0.993 / 1.005 -> 0.997 / 0.999.
-    {"studio", "front", 1.31, {1.019, 1.038, 0.973, 1.014, 1.007}, 1.129, 0.16},
-    {"studio", "threequarter", 1.64, {1.012, 1.054, 0.961, 1.024, 0.999}, 1.002, 0.08},
-    {"daylight", "front", 1.15, {0.995, 1.054, 1.036, 1.018, 1.031}, 0.997, 0.00},
-    {"daylight", "threequarter", 1.16, {0.973, 1.056, 0.993, 1.009, 1.020}, 0.999, 0.00},
-    {"office", "front", 1.49, {1.021, 1.045, 1.056, 1.009, 0.988}, 1.056, 0.00},
-    {"office", "threequarter", 1.38, {0.976, 1.047, 1.017, 0.995, 0.959}, 1.060, 0.01},
-    {"sunset", "front", 0.88, {1.008, 1.061, 1.016, 1.018, 1.026}, 1.014, 0.02},
-    {"sunset", "threequarter", 0.98, {1.012, 1.063, 0.996, 1.010, 1.022}, 1.005, 0.00},
+    // 0.98 (with the bent normal per pixel in an RGBA8 target: 1.31 / 1.64, 1.14 / 1.17, 1.49 / 1.38, 0.89 /
+    // 0.99); band studio 3/4 0.994 -> 1.001, daylight 0.993 / 1.005 -> 0.997 / 1.001 (which of 0.999 and
+    // 1.001 daylight 3/4 reads is the per-pixel bent normal's storage precision, not the light).
+    {"studio", "front", 1.31, {1.020, 1.038, 0.973, 1.014, 1.007}, 1.129, 0.17},
+    {"studio", "threequarter", 1.64, {1.012, 1.054, 0.961, 1.025, 0.999}, 1.001, 0.08},
+    {"daylight", "front", 1.14, {0.995, 1.053, 1.034, 1.016, 1.031}, 0.997, 0.00},
+    {"daylight", "threequarter", 1.17, {0.973, 1.054, 0.991, 1.006, 1.018}, 1.001, 0.00},
+    {"office", "front", 1.49, {1.021, 1.045, 1.055, 1.009, 0.988}, 1.056, 0.00},
+    {"office", "threequarter", 1.38, {0.977, 1.047, 1.017, 0.995, 0.960}, 1.060, 0.01},
+    {"sunset", "front", 0.89, {1.008, 1.061, 1.016, 1.018, 1.026}, 1.013, 0.01},
+    {"sunset", "threequarter", 0.99, {1.013, 1.062, 0.995, 1.010, 1.021}, 1.006, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87

@@ -205,7 +205,7 @@ static GLuint fbo_with(const GLuint *colour, int ncolour, GLuint depth)
 static double target_estimate(int w, int h, bool float_rt)
 {
     double px = (double)w * h, acc = float_rt ? 8 : 4;
-    return px * (4 + (RS_ATTR_TARGETS - 1) * acc + acc / 2 + acc + 4 + acc * 4.0 / 3.0 + 8);
+    return px * (4 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + acc * 4.0 / 3.0 + 8);
 }
 
 static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
@@ -220,9 +220,8 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
     release_targets(r);
     GLenum acc = r->float_rt ? GL_RGBA16F : GL_RGBA8;
     r->depth_tex = rs_render_texture(GL_DEPTH_COMPONENT32F, w, h);
-    // The bent normal's target holds two components (attribute.frag.glsl): half the bytes to blend.
-    for (int i = 0; i < RS_ATTR_TARGETS; i++)
-        r->attr_tex[i] = rs_render_texture(i < 3 ? acc : r->float_rt ? GL_RG16F : GL_RG8, w, h);
+    // The bent normal's target is RGBA8 whatever the others are (attribute.frag.glsl).
+    for (int i = 0; i < RS_ATTR_TARGETS; i++) r->attr_tex[i] = rs_render_texture(i < 3 ? acc : GL_RGBA8, w, h);
     r->diffuse_tex = rs_render_texture(acc, w, h);
     r->out_tex = rs_render_texture(GL_RGBA8, w, h);
     const char *acc_name = r->float_rt ? "RGBA16F" : "RGBA8";
@@ -259,7 +258,7 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
 static size_t target_bytes(const rs_renderer *r)
 {
     size_t px = (size_t)r->tw * (size_t)r->th, acc = r->float_rt ? 8 : 4;
-    size_t bytes = px * (4 + (RS_ATTR_TARGETS - 1) * acc + acc / 2 + acc + 4);  // depth, attributes, D, out
+    size_t bytes = px * (4 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4);  // depth, attributes, D, out
     for (int i = 0; i < RS_LEVEL_DIVS; i++)
         if (r->level_tex[i]) bytes += px * acc >> (2 * i);
     return bytes;

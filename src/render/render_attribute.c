@@ -69,7 +69,7 @@ rs_result rs_render_attributes(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform1f(rs_uloc(prog, "u_inv_two_sigma2"), 1.0f / (2.0f * ATTR_SIGMA * ATTR_SIGMA));
     glUniform1f(rs_uloc(prog, "u_weight_scale"), r->float_rt ? 1.0f : RS_ATTR_WEIGHT_SCALE_RGBA8);
     glUniform1f(rs_uloc(prog, "u_weight_floor"), r->float_rt ? 0.0f : RS_ATTR_WEIGHT_FLOOR_RGBA8);
-    glUniform2fv(rs_uloc(prog, "u_bent_code"), 1, r->float_rt ? (const float[2]){1, 0} : (const float[2]){0.5f, 0.5f});
+    glUniform1f(rs_uloc(prog, "u_bent_scale"), r->float_rt ? RS_ATTR_WEIGHT_SCALE_RGBA8 : 1.0f);
     glUniform1f(rs_uloc(prog, "u_env_on"), f->env_on ? 1.0f : 0.0f);
     glUniform1f(rs_uloc(prog, "u_makeup_on"), f->view.hide_makeup ? 0.0f : 1.0f);
     glUniform3fv(rs_uloc(prog, "rs_makeup_range_lo"), 1, r->makeup_uni.range_lo);

@@ -59,7 +59,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     // RGBA8 fallback: a sum of a few 8-bit steps is a faint disk rim rounded to garbage colours; such
     // pixels are filled from their neighbours like holes.
     glUniform1f(rs_uloc(prog, "u_min_weight"), r->float_rt ? 0.0f : RS_MIN_WEIGHT_RGBA8);
-    glUniform2fv(rs_uloc(prog, "u_bent_code"), 1, r->float_rt ? (const float[2]){1, 0} : (const float[2]){0.5f, 0.5f});
+    glUniform1f(rs_uloc(prog, "u_bent_scale"), r->float_rt ? RS_ATTR_WEIGHT_SCALE_RGBA8 : 1.0f);
     rs_render_shadow_uniforms(r, f, prog);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
     for (int i = 0; i < RS_ATTR_TARGETS; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
