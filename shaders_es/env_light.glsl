@@ -35,8 +35,8 @@ vec3 rs_env_irradiance(vec3 n_view)
 // 2014). The cone is the cosine lobe cut at the half-angle t with sin^2 t = ao; each SH band is scaled by
 // that cut lobe's zonal coefficient over the whole lobe's: ao (band 0), 1 - cos^3 t (band 1),
 // 1 - 3 cos^4 t + 2 cos^2 t (band 2), all 1 in the open. A hollow's light comes from where its opening
-// looks (a nostril's roof sees the ground, the jaw's underside the horizon), and a narrow opening lights
-// it more directionally. Without bent normals: the hemisphere around n scaled by ao, as before.
+// looks (a nostril's wing sees the ground through the opening, the jaw's underside the horizon), and a
+// narrow opening lights it more directionally. Without bent normals: the hemisphere around n scaled by ao, as before.
 vec3 rs_env_sky(vec3 n_view, vec3 b_view, float ao)
 {
     if (u_env_cones < 0.5) return rs_env_irradiance(n_view) * ao;

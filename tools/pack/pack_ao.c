@@ -6,8 +6,8 @@
 // irradiance and its specular by it (byte 15 of the record, RS_SPLAT_FLAG_AO). The same maps give each
 // splat's bent normal, the cosine-weighted mean of its open directions (RS_SPLAT_FLAG_BENT): the axis of
 // the cone of sky it sees, which the renderer lights instead of a hemisphere around the normal (a nostril's
-// roof faces up but sees the ground through the opening; the jaw's underside faces down but sees the
-// horizon).
+// wing faces sideways but sees the ground through the opening below; the jaw's underside faces down but
+// sees the horizon).
 #define _POSIX_C_SOURCE 200809L  // sysconf
 #include "pack/pack.h"
 
