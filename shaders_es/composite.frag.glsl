@@ -389,10 +389,13 @@ void main()
             float so = ao * open_c * open_r;
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
-            vec2 bt = vec2(t3.x - t3.y, t3.z - t3.w) * (inv / u_bent_scale);
-            vec3 t1, t2;
-            rs_tangents(N, t1, t2);
-            vec3 B = normalize(sqrt(max(1.0 - dot(bt, bt), 0.0)) * N + bt.x * t1 + bt.y * t2);
+            vec3 B = N;  // the bent normal (RT3), where the splats carry one
+            if (u_env_cones > 0.5) {
+                vec2 bt = vec2(t3.x - t3.y, t3.z - t3.w) * (inv / u_bent_scale);
+                vec3 t1, t2;
+                rs_tangents(N, t1, t2);
+                B = normalize(sqrt(max(1.0 - dot(bt, bt), 0.0)) * N + bt.x * t1 + bt.y * t2);
+            }
             E += rs_env_sky(N, B, ao) + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.

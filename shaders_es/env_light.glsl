@@ -17,18 +17,21 @@ uniform float u_env_scale;          // exposure normalisation of the map (the SH
 uniform highp sampler2D u_spec_lut; // (N.V, m) -> (A, B): the lobe's directional albedo is F0 A + B
 uniform float u_env_cones;          // 1: the splats carry bent normals (RS_SPLAT_FLAG_BENT): rs_env_sky's cones
 
-// The SH's irradiance (the environment without its key light and lamps) at view-space normal n_view.
-vec3 rs_env_irradiance(vec3 n_view)
+// The SH's irradiance (the environment without its key light and lamps) in the environment's frame, each
+// band scaled: k.x band 0, k.y band 1, k.z band 2 (1, 1, 1: the whole clamped cosine around n).
+vec3 rs_env_sh_bands(vec3 n, vec3 k)
 {
-    vec3 n = u_env_from_view * n_view;
     // Real SH basis, l <= 2 (Ramamoorthi & Hanrahan 2001 order), the same as rs_env_sh_irradiance.
-    vec3 e = u_env_sh[0] * 0.282095
-           + u_env_sh[1] * (0.488603 * n.y) + u_env_sh[2] * (0.488603 * n.z) + u_env_sh[3] * (0.488603 * n.x)
-           + u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
-           + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
-           + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y));
+    vec3 e = u_env_sh[0] * (0.282095 * k.x)
+           + (u_env_sh[1] * (0.488603 * n.y) + u_env_sh[2] * (0.488603 * n.z) + u_env_sh[3] * (0.488603 * n.x)) * k.y
+           + (u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
+              + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
+              + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y))) * k.z;
     return max(e, vec3(0.0));
 }
+
+// The SH's irradiance at view-space normal n_view.
+vec3 rs_env_irradiance(vec3 n_view) { return rs_env_sh_bands(u_env_from_view * n_view, vec3(1.0)); }
 
 // The SH's irradiance on a surface of normal n_view that sees the sky only through a cone around b_view
 // (its bent normal) holding the (cosine-weighted) share ao of its hemisphere: a bent cone (Klehm et al.
@@ -36,18 +39,13 @@ vec3 rs_env_irradiance(vec3 n_view)
 // that cut lobe's zonal coefficient over the whole lobe's: ao (band 0), 1 - cos^3 t (band 1),
 // 1 - 3 cos^4 t + 2 cos^2 t (band 2), all 1 in the open. A hollow's light comes from where its opening
 // looks (a nostril's wing sees the ground through the opening, the jaw's underside the horizon), and a
-// narrow opening lights it more directionally. Without bent normals: the hemisphere around n scaled by ao, as before.
+// narrow opening lights it more directionally. Without bent normals: the hemisphere around n scaled by ao,
+// as before.
 vec3 rs_env_sky(vec3 n_view, vec3 b_view, float ao)
 {
     if (u_env_cones < 0.5) return rs_env_irradiance(n_view) * ao;
-    vec3 n = u_env_from_view * b_view;
-    float c2 = 1.0 - ao, s1 = 1.0 - c2 * sqrt(c2), s2 = 1.0 - 3.0 * c2 * c2 + 2.0 * c2;
-    vec3 e = u_env_sh[0] * (0.282095 * ao)
-           + (u_env_sh[1] * (0.488603 * n.y) + u_env_sh[2] * (0.488603 * n.z) + u_env_sh[3] * (0.488603 * n.x)) * s1
-           + (u_env_sh[4] * (1.092548 * n.x * n.y) + u_env_sh[5] * (1.092548 * n.y * n.z)
-              + u_env_sh[6] * (0.315392 * (3.0 * n.z * n.z - 1.0)) + u_env_sh[7] * (1.092548 * n.x * n.z)
-              + u_env_sh[8] * (0.546274 * (n.x * n.x - n.y * n.y))) * s2;
-    return max(e, vec3(0.0));
+    float c2 = 1.0 - ao;
+    return rs_env_sh_bands(u_env_from_view * b_view, vec3(ao, 1.0 - c2 * sqrt(c2), 1.0 - 3.0 * c2 * c2 + 2.0 * c2));
 }
 
 // How much of each lamp reaches the view-space point p with normal n_view (its shadow map; 1 unshadowed).

@@ -64,9 +64,9 @@ static rs_result render_sky(float tilt, rs_image *out, rs_error *err)
             for (int k = 0; k < 3; k++) b[k] /= sqrtf(l);
         }
         // The same normals either way: set, then (tilt < 0) cleared, which keeps them.
-        rs_splat_set_bent(face, (const float(*)[3])bent);
-        if (tilt < 0) rs_splat_set_bent(face, NULL);
-        res = rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &r, err);
+        res = rs_splat_set_bent(face, (const float(*)[3])bent, err);
+        if (!res && tilt < 0) res = rs_splat_set_bent(face, NULL, err);
+        if (!res) res = rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl)}, &r, err);
     }
     if (!res) res = rs_render_set_env(r, env, err);
     if (!res) {

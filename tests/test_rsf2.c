@@ -241,8 +241,13 @@ static void test_bent_normals_round_trip_and_survive_files(void)
         for (int k = 0; k < 3; k++)
             bent[i][k] = (float)(cos(a) * m[k] + sin(a) * t[k] / sqrt(fmax(tl, 1e-12)));
     }
+    rs_error err0 = {0};
+    // Bent normals need the occlusion (their cone's opening): refused without it, with a message.
+    RS_CHECK(rs_splat_set_bent(c, (const float(*)[3])bent, &err0) == RS_ERR_ARG && strstr(err0.msg, "ambient occlusion") &&
+                 !(c->hdr.flags & RS_SPLAT_FLAG_BENT),
+             "bent normals set on a cloud without occlusion: %s", err0.msg);
     rs_splat_set_ao(c, ao);
-    rs_splat_set_bent(c, (const float(*)[3])bent);
+    RS_REQUIRE(rs_splat_set_bent(c, (const float(*)[3])bent, &err0) == RS_OK, "%s", err0.msg);
     RS_REQUIRE(c->hdr.flags & RS_SPLAT_FLAG_BENT, "rs_splat_set_bent did not set the flag");
     double worst_bent = 0, worst_normal = 0, worst_same = 0;
     bool get_agrees = true;
@@ -281,15 +286,25 @@ static void test_bent_normals_round_trip_and_survive_files(void)
         rs_splat_destroy(d);
         d = NULL;
     }
+    // A header copied from such a cloud cannot create one from float splats (which carry no bent normals).
+    rs_splat s4[4];
+    for (uint32_t i = 0; i < 4; i++) rs_splat_get(c, i, &s4[i]);
+    rs_splat_header h4 = c->hdr;
+    h4.lod_count = 1, h4.lods[0] = 4;
+    rs_splat_cloud *e = NULL;
+    RS_CHECK(rs_splat_create(s4, 4, &h4, &e, &err0) == RS_ERR_ARG && strstr(err0.msg, "RS_SPLAT_FLAG_BENT") && !e,
+             "rs_splat_create took RS_SPLAT_FLAG_BENT: %s", err0.msg);
+    rs_splat_destroy(e);
     memcpy(before, c->normal, sizeof *before * n);
-    rs_splat_set_bent(c, NULL);
-    bool kept = !(c->hdr.flags & RS_SPLAT_FLAG_BENT);
+    // Removing the occlusion removes the bent normals with it (a file must not have one without the other).
+    rs_splat_set_ao(c, NULL);
+    bool kept = !(c->hdr.flags & (RS_SPLAT_FLAG_BENT | RS_SPLAT_FLAG_AO));
     for (uint32_t i = 0; i < n; i++) {
         float b[3];
         rs_splat_bent(c, i, b);
         kept &= memcmp(before[i], c->normal[i], sizeof b) == 0 && memcmp(b, c->normal[i], sizeof b) == 0;
     }
-    RS_CHECK(kept, "clearing the bent normals moved the normals or left the flag");
+    RS_CHECK(kept, "clearing the occlusion moved the normals or left the bent normals' flag");
     free(ao), free(bent), free(before);
     rs_splat_destroy(c);
 }

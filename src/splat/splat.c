@@ -730,7 +730,7 @@ void rs_splat_set_ao(rs_splat_cloud *c, const uint8_t *ao)
     for (uint32_t i = 0; i < c->hdr.count; i++)
         c->packed[i].w[3] = (c->packed[i].w[3] & 0x00ffffffu) | (ao ? (uint32_t)ao[i] << 24 : 0u);
     if (ao) c->hdr.flags |= RS_SPLAT_FLAG_AO;
-    else c->hdr.flags &= ~RS_SPLAT_FLAG_AO;
+    else c->hdr.flags &= ~RS_SPLAT_FLAG_AO, rs_splat_set_bent(c, NULL, NULL);  // a cone needs its opening
 }
 
 float rs_splat_ao(const rs_splat_cloud *c, uint32_t i)
@@ -738,17 +738,21 @@ float rs_splat_ao(const rs_splat_cloud *c, uint32_t i)
     return (c->hdr.flags & RS_SPLAT_FLAG_AO) ? (float)(c->packed[i].w[3] >> 24) / 255.0f : 1.0f;
 }
 
-void rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3])
+rs_result rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3], rs_error *err)
 {
     if (!bent) {
-        for (uint32_t i = 0; i < c->hdr.count; i++) c->packed[i].w[2] &= 0xffc0ffc0u;
+        if (c->hdr.flags & RS_SPLAT_FLAG_BENT)
+            for (uint32_t i = 0; i < c->hdr.count; i++) c->packed[i].w[2] &= 0xffc0ffc0u;
         c->hdr.flags &= ~RS_SPLAT_FLAG_BENT;
-        return;
+        return RS_OK;
     }
+    if (!(c->hdr.flags & RS_SPLAT_FLAG_AO))
+        return rs_fail(err, RS_ERR_ARG, "bent normals: the cloud has no ambient occlusion (rs_splat_set_ao first)");
     if (!(c->hdr.flags & RS_SPLAT_FLAG_BENT)) rs_splat_quantize_normals(c, 10);
     for (uint32_t i = 0; i < c->hdr.count; i++)
         c->packed[i].w[2] = (c->packed[i].w[2] & 0xffc0ffc0u) | encode_bent(bent[i], c->normal[i]);
     c->hdr.flags |= RS_SPLAT_FLAG_BENT;
+    return RS_OK;
 }
 
 void rs_splat_bent(const rs_splat_cloud *c, uint32_t i, float out[3])

@@ -179,15 +179,15 @@ rs_result rs_splat_loader_finish(rs_splat_loader *l, rs_splat_cloud **out, rs_er
 // Decodes record i (as the GPU sees it).
 void rs_splat_get(const rs_splat_cloud *c, uint32_t i, rs_splat *out);
 // Per-splat ambient occlusion (byte 15, RS_SPLAT_FLAG_AO): sets it from ao[count] (q/255, 255 = open sky)
-// or removes it (NULL); reads it (1 when the cloud has none).
+// or removes it (NULL; the bent normals go with it); reads it (1 when the cloud has none).
 void rs_splat_set_ao(rs_splat_cloud *c, const uint8_t *ao);
 float rs_splat_ao(const rs_splat_cloud *c, uint32_t i);
 // Per-splat bent normal (RS_SPLAT_FLAG_BENT): the cosine-weighted mean of the directions a splat sees the
 // sky in, unit, model space; with the occlusion it makes a cone of visible sky that environments light
-// (bent cones). Setting it (bent[count], unit vectors; the cloud must have ambient occlusion) moves every
-// normal onto the 10-bit lattice the bits leave; NULL removes it (the normals stay where they are).
+// (bent cones). Setting it (bent[count], unit vectors) moves every normal onto the 10-bit lattice the bits
+// leave, and fails on a cloud without ambient occlusion; NULL removes it (the normals stay where they are).
 // Reading gives the normal when the cloud has none.
-void rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3]);
+rs_result rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3], rs_error *err);
 void rs_splat_bent(const rs_splat_cloud *c, uint32_t i, float out[3]);
 // Largest LOD prefix from the table with at most max_count splats (the smallest level if none fits).
 uint32_t rs_splat_lod_count(const rs_splat_cloud *c, uint32_t max_count);

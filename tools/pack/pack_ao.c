@@ -307,7 +307,7 @@ rs_result rs_pack_ao_cloud(rs_splat_cloud *c, rs_error *err)
     for (uint32_t l = 0; l < c->hdr.lod_count; l++)
         if (c->hdr.lods[l] >= AO_MIN_OCCLUDERS && c->hdr.lods[l] < occluders) occluders = c->hdr.lods[l];
     if (r == RS_OK) r = rs_pack_ao_prefix(s, n, occluders, ao, bent, err);
-    if (r == RS_OK) rs_splat_set_ao(c, ao), rs_splat_set_bent(c, (const float(*)[3])bent);
+    if (r == RS_OK) rs_splat_set_ao(c, ao), r = rs_splat_set_bent(c, (const float(*)[3])bent, err);
     free(s);
     free(ao);
     free(bent);
