@@ -1,15 +1,19 @@
 #version 300 es
 // diffusion.vert.glsl — stage 4, splat-based diffusion (Kim et al. 2010): per splat, its irradiance (from
-// the frame's irradiance pass, irradiance.vert.glsl) and an isotropic 3D Gaussian kernel of one level of
+// the irradiance pass, irradiance.vert.glsl) and an isotropic 3D Gaussian kernel of one level of
 // the skin profile, drawn as a sprite covering 3 sigma around the splat centre.
 precision highp float;
 precision highp int;
 #include "splat_decode.glsl"
 #include "splat_sprite.glsl"
+#include "behind_surface.glsl"
 
 layout(location = 0) in uvec4 a_splat;
-layout(location = 2) in vec4 a_irradiance;  // (E, distance behind the visible surface or -1)
+layout(location = 2) in vec3 a_irradiance;  // E
 uniform mat4 u_view;
+uniform mat4 u_inv_proj;
+uniform highp sampler2D u_depth;  // visibility depth
+uniform float u_eps;
 uniform float u_radius_scale;   // LOD of this level: sqrt(N / n)
 uniform float u_sigma;          // the level's Gaussian sigma, view units (sqrt(variance_mm2) / mm_per_unit)
 uniform float u_px_size;        // size of a pixel at view distance 1, view units
@@ -29,13 +33,14 @@ void main()
     // speckles) nor than a pixel (else detail aliases): below that the level is a smooth interpolation.
     float sigma = max(u_sigma, 0.5 * max(r, -c.z * u_px_size));
     // Back-facing splats deep behind the visible surface (the back of the head) reach no visible pixel.
-    if (a_irradiance.a > 3.0 * sigma) {
+    if (dot(mat3(u_view) * s.normal, -c) < 0.0
+        && rs_behind_visible(c, u_proj, u_inv_proj, u_depth, u_eps) > 3.0 * sigma) {
         rs_sprite_cull();
         return;
     }
     float v = sigma * sigma;
     v_c = c;
-    v_e = a_irradiance.rgb;
+    v_e = a_irradiance;
     v_k = 0.5 / v;
     v_a = r * r / (6.2831853 * v);
     v_cut2 = 9.0 * v;

@@ -53,7 +53,7 @@ static void setup_vao(rs_renderer *r, GLuint vao, GLuint divisor, bool feedback)
     }
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_irradiance);
     glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 4, GL_FLOAT, GL_FALSE, 16, (void *)0);
+    glVertexAttribPointer(2, 3, GL_FLOAT, GL_FALSE, RS_IRRADIANCE_BYTES, (void *)0);
     glVertexAttribDivisor(2, divisor);
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_makeup);
     glEnableVertexAttribArray(1);
@@ -127,7 +127,8 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
     free(zeros);
     glGenBuffers(1, &r->vbo_irradiance);
     glBindBuffer(GL_ARRAY_BUFFER, r->vbo_irradiance);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes_splats, NULL, GL_DYNAMIC_COPY);
+    size_t bytes_irradiance = (size_t)c->hdr.count * RS_IRRADIANCE_BYTES;  // < bytes_splats
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)bytes_irradiance, NULL, GL_DYNAMIC_COPY);
     glGenVertexArrays(1, &r->vao_points);
     glGenVertexArrays(1, &r->vao_quads);
     glGenVertexArrays(1, &r->vao_empty);
@@ -135,7 +136,7 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
     setup_vao(r, r->vao_points, 0, false);
     setup_vao(r, r->vao_quads, 1, false);
     setup_vao(r, r->vao_feedback, 0, true);
-    r->stats.gpu_bytes = 2 * bytes_splats + bytes_makeup;
+    r->stats.gpu_bytes = bytes_splats + bytes_irradiance + bytes_makeup;
     r->stats.float_targets = r->float_rt;
     rs_result res = rs_gl_check("render: uploading the splats", err);
     if (res != RS_OK) {

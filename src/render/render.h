@@ -138,6 +138,7 @@ typedef enum rs_render_stage {
 typedef struct rs_render_stats {
     uint32_t splats_drawn;           // main passes
     uint32_t diffusion_splats;       // summed over diffusion levels
+    bool irradiance_kept;            // stage 4 reused the splats' irradiance of an earlier frame (same lights)
     int kernel_count;
     bool used_points;                // point sprites (true) or instanced quads (false)
     bool float_targets;

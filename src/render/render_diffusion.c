@@ -24,7 +24,10 @@
 // at half or quarter resolution; the resolve upsamples them depth-aware (diffusion_resolve.frag.glsl).
 // On the bundled head at 512x512 that leaves one level (sigma ~1.7 mm, the 74k prefix, 128x128).
 // Splats no level carries to a visible pixel (the back of the head, off-screen shoulders) skip the
-// irradiance pass's shadow lookup (both pipelines; the image is unchanged).
+// irradiance pass's shadow lookup (both pipelines; the image is unchanged). The splats' irradiance depends
+// on the lights, not on the camera, so it is kept while they hold still (irradiance_pass): an orbit's
+// frames draw the levels from the same per-splat E, and each level culls the splats behind the visible
+// surface itself (behind_surface.glsl).
 //
 // RGBA8 fallback (no float targets): E is scaled by 1 / (its largest possible value) and the weights by
 // 1/4 (their sum is ~ (r / spacing)^2 ~ 1.7 by construction) so the level sums stay below 1; D is stored
@@ -33,6 +36,7 @@
 // steps (reached only by kernels' faint tails) borrows its 3x3 neighbours' sums. Coarser, but it runs.
 #include "render/render_stages.h"
 
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -212,21 +216,59 @@ static rs_result draw_level(rs_renderer *r, const rs_frame *f, const rs_diffusio
     return RS_OK;
 }
 
-// Per-splat irradiance and "behind the visible surface" distance for the frame's first `count` splats
-// (every level draws a prefix of those), by transform feedback: the shadow-map PCF runs once per splat
-// instead of once per splat and level.
+// What the splats' irradiance depends on besides the splats: the lights in model space, the shadows,
+// the LOD prefix (and with it the shadow map's). Not the camera: E is kept across views while this holds.
+static void irradiance_key(const rs_frame *f, float k[RS_IRR_KEY])
+{
+    mat3 inv_rot;
+    glm_mat4_pick3((vec4 *)f->cam.inv_view, inv_rot);
+    glm_mat3_mulv(inv_rot, (float *)f->key_dir, k);
+    glm_mat3_mulv(inv_rot, (float *)f->fill_dir, k + 3);
+    memcpy(k + 6, f->key_color, 3 * sizeof(float));
+    memcpy(k + 9, f->fill_color, 3 * sizeof(float));
+    memcpy(k + 12, f->ambient, 3 * sizeof(float));
+    k[15] = f->env_on ? 1.0f : 0.0f;
+    k[16] = f->env_on ? f->view.env_rotate_deg : 0.0f;
+    k[17] = f->env_on ? f->view.env_intensity : 0.0f;
+    k[18] = f->shadows ? 1.0f : 0.0f;
+    k[19] = (float)f->shadow_slot;
+    k[20] = (float)f->count;
+    k[21] = f->eps;
+}
+
+// Within float rounding: a direction brought back to model space differs in its last bits from view to
+// view (as the shadow maps' keys, render_shadow.c).
+static bool irradiance_key_holds(const float a[RS_IRR_KEY], const float b[RS_IRR_KEY])
+{
+    for (int i = 0; i < RS_IRR_KEY; i++)
+        if (!(fabsf(a[i] - b[i]) <= 1e-5f * fmaxf(1.0f, fabsf(b[i])))) return false;
+    return true;
+}
+
+// Per-splat irradiance for the frame's first `count` splats (every level draws a prefix of those), by
+// transform feedback: the shadow-map PCF runs once per splat instead of once per splat and level. E does
+// not depend on the camera: while the lights hold still the pass runs once more over every splat of the
+// prefix and then not at all (orbiting, zooming within a LOD prefix, painting), until they move.
 static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                                  rs_error *err)
 {
+    float key[RS_IRR_KEY];
+    irradiance_key(f, key);
+    bool held = r->irr_state > 0 && irradiance_key_holds(key, r->irr_key);
+    r->stats.irradiance_kept = held && r->irr_state == 2;
+    if (r->stats.irradiance_kept) return RS_OK;
     // The farthest any level's kernel reaches (its sigma, or the floor of the widest splat of its prefix,
     // or of a pixel at the far end of the cloud): splats deeper behind the visible surface or farther
-    // outside the view than this reach no pixel, so their shadow lookup is skipped.
+    // outside the view than this reach no pixel, so their shadow lookup is skipped -- unless the result
+    // is to be kept for other views.
     float reach = 0;
     for (int i = 0; i < count; i++) {
         float rmax = r->cloud->hdr.radius_max * rs_splat_lod_radius_scale(r->cloud, levels[i].count);
         float px = f->cam.px_size * (float)levels[i].res_div * f->cam.far_z;
         reach = fmaxf(reach, 3.0f * fmaxf(levels[i].sigma, 0.5f * fmaxf(rmax, px)));
     }
+    if (held) reach = FLT_MAX;
+    r->irr_state = 0;
     GLuint prog;
     rs_result res = rs_render_program(r, RS_PROG_IRRADIANCE, false, &prog, err);
     if (res != RS_OK) return res;
@@ -235,7 +277,6 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     glUniformMatrix4fv(rs_uloc(prog, "u_view"), 1, GL_FALSE, (const float *)cam->view);
     glUniformMatrix4fv(rs_uloc(prog, "u_proj"), 1, GL_FALSE, (const float *)cam->proj);
     glUniformMatrix4fv(rs_uloc(prog, "u_inv_proj"), 1, GL_FALSE, (const float *)cam->inv_proj);
-    glUniform2f(rs_uloc(prog, "u_viewport"), (float)cam->width, (float)cam->height);
     glUniform1f(rs_uloc(prog, "u_eps"), f->eps);
     glUniform3fv(rs_uloc(prog, "u_key_dir"), 1, f->key_dir);
     glUniform3fv(rs_uloc(prog, "u_key_color"), 1, f->key_color);
@@ -257,12 +298,17 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     glEndTransformFeedback();
     glDisable(GL_RASTERIZER_DISCARD);
     glBindBufferBase(GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0);
-    return rs_gl_check("render: irradiance pass", err);
+    res = rs_gl_check("render: irradiance pass", err);
+    if (res != RS_OK) return res;
+    memcpy(r->irr_key, key, sizeof key);
+    r->irr_state = held ? 2 : 1;
+    return RS_OK;
 }
 
 rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                               rs_error *err)
 {
+    r->stats.irradiance_kept = false;
     if (count > 0) {
         rs_result res = irradiance_pass(r, f, levels, count, err);
         if (res != RS_OK) return res;

@@ -299,6 +299,7 @@ static void facing_irradiance(const float sh[9][3], const float light_dir[3], co
 rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
 {
     r->inc_valid = false;
+    r->irr_state = 0;
     if (r->env_tex) glDeleteTextures(1, &r->env_tex);
     r->env_tex = 0;
     memset(&r->env, 0, sizeof r->env);

@@ -127,6 +127,8 @@ typedef struct rs_diffusion_level {
 
 // Level targets exist at full, half and quarter resolution (rs_diffusion_level.res_div 1, 2, 4).
 #define RS_LEVEL_DIVS 3
+#define RS_IRRADIANCE_BYTES 12  // per splat: E, 3 floats (irradiance.vert.glsl)
+#define RS_IRR_KEY 22           // floats in the irradiance pass's key (render_diffusion.c irradiance_key)
 
 // The mobile pipeline's defaults (render_view.c, render_diffusion.c; docs/mobile.md has the measurements).
 // Main passes: the LOD prefix nearest (in log) to this many visible splats per pixel of the face's screen
@@ -213,7 +215,7 @@ struct rs_renderer {
     float bound_centre[3], bound_radius;  // bounding sphere of the quantization box
 
     GLuint vbo_splats, vbo_makeup;
-    GLuint vbo_irradiance;      // per splat (E, behind), 16 bytes, written by the irradiance pass
+    GLuint vbo_irradiance;      // per splat E (RS_IRRADIANCE_BYTES), the irradiance pass's (render_diffusion.c)
     GLuint vao_points, vao_quads, vao_empty;
     GLuint vao_feedback;        // the splats alone (the irradiance buffer is the feedback target there)
     GLuint prog[RS_PROG_COUNT][2];   // [kind][quads]; 0 until first use
@@ -224,6 +226,11 @@ struct rs_renderer {
     GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_out;
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;
+    // The irradiance pass's key (render_diffusion.c): the lights in model space, the LOD prefix. Kept E:
+    // 0 none, 1 the splats seen from the last view only, 2 every splat of the prefix (reused while the
+    // key holds). A shadow map's redraw or a new environment drops it.
+    float irr_key[RS_IRR_KEY];
+    int irr_state;
 
     // Shadow maps (reference, mobile), re-rendered only when the light or the LOD changes.
     rs_shadow_map shadow[2];
