@@ -24,3 +24,12 @@ vec3 rs_bounce(float v, vec3 albedo)
 {
     return (rs_multibounce(v, clamp(albedo, 0.0, 1.0)) - v) * u_env_surround;
 }
+
+// The radiance of that skin in the directions the occlusion hides: rs_bounce over the hidden share (1 - v),
+// by dividing the cubic's (fit - v) by (1 - v) in closed form (its value at v = 1 is 1 within 5e-4, which
+// is dropped), so that it holds up as v -> 1.
+vec3 rs_hidden_radiance(float v, vec3 albedo)
+{
+    vec3 a = clamp(albedo, 0.0, 1.0);
+    return max(-v * ((2.0404 * a - 0.3324) * (v + 1.0) - 4.7951 * a + 0.6417), 0.0) * u_env_surround;
+}

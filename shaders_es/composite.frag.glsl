@@ -252,10 +252,12 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
 // no highlight there and rouge drew a white streak down the nose at the physical strength (issue 22). So
 // R is marched 2.5 to 80 mm (steps doubling: an ear's folds are a few mm deep) through the depth buffer: a point that lies behind the visible
 // surface at its pixel by more than 1-3 mm (and less than a head's depth: beyond that the ray passes
-// behind the head) is inside the head and blocks the reflection. Background and the frame's edge leave it
-// open. hit: the pixel of the surface that blocks it most.
-float reflection_open(vec3 p, vec3 R, inout ivec2 hit)
+// behind the head) is inside the head and blocks the reflection. Background leaves it open. hit: the pixel
+// of the surface that blocks it most; left: the march ran off the frame, past what the depth buffer knows
+// (the caller asks the splat's bent cone then).
+float reflection_open(vec3 p, vec3 R, inout ivec2 hit, out bool left)
 {
+    left = false;
     float open = 1.0;
     float d = 0.125 * u_contour_reach;
     // The march's points in clip space are linear in d: no projection per step.
@@ -265,7 +267,10 @@ float reflection_open(vec3 p, vec3 R, inout ivec2 hit)
         if (q.z > -1e-3) break;  // passes the eye's plane: in front of everything the camera sees
         vec4 c = cp + cr * d;
         vec2 f = (c.xy / c.w * 0.5 + 0.5) * u_viewport;
-        if (any(lessThan(f, vec2(0.0))) || any(greaterThanEqual(f, u_viewport))) break;
+        if (any(lessThan(f, vec2(0.0))) || any(greaterThanEqual(f, u_viewport))) {
+            left = true;
+            break;
+        }
         vec3 s;
         if (!rs_visible_point_at(rs_depth_pixel(f), s)) continue;
         float behind = s.z - q.z;
@@ -385,8 +390,9 @@ void main()
             float ndotv = dot(N, V);
             ivec2 hit_c = ivec2(-1), hit_r = ivec2(-1);
             float open_c = contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv), hit_c);
-            float open_r = reflection_open(p, reflect(-V, N), hit_r);
-            float so = ao * open_c * open_r;
+            bool left;
+            vec3 Rv = reflect(-V, N);
+            float open_r = reflection_open(p, Rv, hit_r, left);
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
             vec3 B = N;  // the bent normal (RT3), where the splats carry one
@@ -396,6 +402,17 @@ void main()
                 rs_tangents(N, t1, t2);
                 B = normalize(sqrt(max(1.0 - dot(bt, bt), 0.0)) * N + bt.x * t1 + bt.y * t2);
             }
+            // A reflection that runs off the frame unblocked (under the jaw: down into the neck the frame
+            // cuts off, which the path tracer's skin mirrors) is decided by what the converter saw in every
+            // direction instead: the splat's bent cone, around B with the occlusion's share (sin^2 of its
+            // half-angle = ao; soft over +-0.1 in cosine: a model of the open directions, not their outline).
+            // Outside it the lobe sees the skin around, at the radiance the bounce gives that share.
+            float open_cone = 1.0;
+            if (left && u_env_cones > 0.5) {
+                float ct = sqrt(max(1.0 - ao, 0.0));
+                open_cone = smoothstep(ct - 0.1, ct + 0.1, dot(Rv, B));
+            }
+            float so = ao * open_c * open_r * open_cone;
             E += rs_env_sky(N, B, ao) + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
@@ -417,6 +434,8 @@ void main()
             ivec2 hit = wc >= wr ? hit_c : hit_r;
             if (wc + wr > 0.02 && hit.x >= 0)
                 S += skin_at(hit) * ((wc + wr) * ao * lobe);
+            float wk = open_c * open_r * (1.0 - open_cone);
+            if (wk > 0.0) S += rs_hidden_radiance(ao, A) * (wk * ao * lobe);
             if (coat > 0.0)
                 C += (rs_env_specular(N, V, mc, RS_F0_COAT) + rs_env_lamp_specular(N, V, mc, RS_F0_COAT, vis, spread)) * so;
         }

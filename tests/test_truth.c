@@ -77,14 +77,20 @@ static const measured was[] = {
     // 0.98 (with the bent normal per pixel in an RGBA8 target: 1.31 / 1.64, 1.14 / 1.17, 1.49 / 1.38, 0.89 /
     // 0.99); band studio 3/4 0.994 -> 1.001, daylight 0.993 / 1.005 -> 0.997 / 1.001 (which of 0.999 and
     // 1.001 daylight 3/4 reads is the per-pixel bent normal's storage precision, not the light).
-    {"studio", "front", 1.31, {1.020, 1.038, 0.973, 1.014, 1.007}, 1.129, 0.17},
-    {"studio", "threequarter", 1.64, {1.012, 1.054, 0.961, 1.025, 0.999}, 1.001, 0.08},
-    {"daylight", "front", 1.14, {0.995, 1.053, 1.034, 1.016, 1.031}, 0.997, 0.00},
-    {"daylight", "threequarter", 1.17, {0.973, 1.054, 0.991, 1.006, 1.018}, 1.001, 0.00},
-    {"office", "front", 1.49, {1.021, 1.045, 1.055, 1.009, 0.988}, 1.056, 0.00},
-    {"office", "threequarter", 1.38, {0.977, 1.047, 1.017, 0.995, 0.960}, 1.060, 0.01},
-    {"sunset", "front", 0.89, {1.008, 1.061, 1.016, 1.018, 1.026}, 1.013, 0.01},
-    {"sunset", "threequarter", 0.99, {1.013, 1.062, 0.995, 1.010, 1.021}, 1.006, 0.00},
+    // A reflection that runs off the frame unblocked asks the splat's bent cone (composite.frag.glsl; the
+    // neck under the jaw, cut off by the frame, which the path tracer's skin mirrors): dE studio 1.31 / 1.64
+    // -> 1.29 / 1.61, daylight 1.14 / 1.17 -> 1.12 / 1.15, office 1.49 / 1.38 -> 1.44 / 1.37, sunset 0.89 /
+    // 0.99 -> 0.87 / 0.96; bands within 0.002. Daylight front's band under the jaw stays 0.991: at 768 px
+    // the reference's skin there is lit 3x more by its specular (its glossy passes: reflecting the neck)
+    // while rouge's reflection march and bent cone both find that direction open.
+    {"studio", "front", 1.29, {1.013, 1.039, 0.974, 1.015, 1.007}, 1.130, 0.17},
+    {"studio", "threequarter", 1.61, {1.006, 1.055, 0.983, 1.025, 0.999}, 1.003, 0.08},
+    {"daylight", "front", 1.12, {0.990, 1.053, 1.035, 1.017, 1.031}, 0.997, 0.00},
+    {"daylight", "threequarter", 1.15, {0.967, 1.054, 0.991, 1.007, 1.019}, 1.002, 0.00},
+    {"office", "front", 1.44, {1.031, 1.044, 1.055, 1.008, 0.988}, 1.054, 0.00},
+    {"office", "threequarter", 1.37, {0.973, 1.048, 1.022, 0.995, 0.960}, 1.059, 0.01},
+    {"sunset", "front", 0.87, {1.001, 1.061, 1.017, 1.019, 1.027}, 1.014, 0.01},
+    {"sunset", "threequarter", 0.96, {1.004, 1.062, 0.997, 1.010, 1.021}, 1.007, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
