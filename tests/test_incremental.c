@@ -146,9 +146,12 @@ static void test_kept_irradiance(void)
               RS_CHECK(rs_render_set_env(r, env, &err) == RS_OK, "%s", err.msg);
     rs_view v = rs_view_defaults();
     v.width = v.height = SIZE, v.pipeline = RS_PIPELINE_MOBILE;
-    // One side of the head, then the other (the first frame computed only what it saw), then the front.
+    // One side of the head (again: the same view reuses what it computed), then the other (the first frame
+    // computed only what it saw), then the front.
     v.yaw_deg = -70;
     ok = ok && kept_frame(r, &v, env, false, "environment, left profile");
+    rs_render_invalidate(r);  // a full frame, not an incremental one (which runs no stage 4)
+    ok = ok && kept_frame(r, &v, env, true, "environment, left profile again");
     v.yaw_deg = 70;
     ok = ok && kept_frame(r, &v, env, false, "environment, right profile (lights held: every splat)");
     v.yaw_deg = 10, v.pitch_deg = -15;

@@ -386,6 +386,7 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
                            nums[i]);
     double t_start = rs_time_now(), t = t_start;
     memset(r->stats.stage_ms, 0, sizeof r->stats.stage_ms);
+    r->stats.irradiance_kept = false;  // until stage 4 says so (an incremental frame does not run it)
     if (r->time_stages) glFinish();
 
     rs_frame f;

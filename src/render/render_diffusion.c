@@ -247,15 +247,18 @@ static bool irradiance_key_holds(const float a[RS_IRR_KEY], const float b[RS_IRR
 
 // Per-splat irradiance for the frame's first `count` splats (every level draws a prefix of those), by
 // transform feedback: the shadow-map PCF runs once per splat instead of once per splat and level. E does
-// not depend on the camera: while the lights hold still the pass runs once more over every splat of the
-// prefix and then not at all (orbiting, zooming within a LOD prefix, painting), until they move.
+// not depend on the camera: while the lights hold still, the same view reuses it, and the first other
+// view runs the pass once more over every splat of the prefix, which then serves every view (orbiting,
+// zooming within a LOD prefix, painting) until the lights move.
 static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                                  rs_error *err)
 {
     float key[RS_IRR_KEY];
     irradiance_key(f, key);
     bool held = r->irr_state > 0 && irradiance_key_holds(key, r->irr_key);
-    r->stats.irradiance_kept = held && r->irr_state == 2;
+    bool same_view = memcmp(r->irr_view, f->cam.view, sizeof(mat4)) == 0 &&
+                     memcmp(r->irr_proj, f->cam.proj, sizeof(mat4)) == 0;
+    r->stats.irradiance_kept = held && (r->irr_state == 2 || same_view);
     if (r->stats.irradiance_kept) return RS_OK;
     // The farthest any level's kernel reaches (its sigma, or the floor of the widest splat of its prefix,
     // or of a pixel at the far end of the cloud): splats deeper behind the visible surface or farther
@@ -301,6 +304,8 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     res = rs_gl_check("render: irradiance pass", err);
     if (res != RS_OK) return res;
     memcpy(r->irr_key, key, sizeof key);
+    memcpy(r->irr_view, f->cam.view, sizeof(mat4));
+    memcpy(r->irr_proj, f->cam.proj, sizeof(mat4));
     r->irr_state = held ? 2 : 1;
     return RS_OK;
 }
@@ -308,7 +313,6 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
 rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                               rs_error *err)
 {
-    r->stats.irradiance_kept = false;
     if (count > 0) {
         rs_result res = irradiance_pass(r, f, levels, count, err);
         if (res != RS_OK) return res;

@@ -227,10 +227,11 @@ struct rs_renderer {
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;
     // The irradiance pass's key (render_diffusion.c): the lights in model space, the LOD prefix. Kept E:
-    // 0 none, 1 the splats seen from the last view only, 2 every splat of the prefix (reused while the
-    // key holds). A shadow map's redraw or a new environment drops it.
+    // 0 none, 1 the splats seen from irr_view / irr_proj only, 2 every splat of the prefix (reused while
+    // the key holds). A shadow map's redraw or a new environment drops it.
     float irr_key[RS_IRR_KEY];
     int irr_state;
+    mat4 irr_view, irr_proj;
 
     // Shadow maps (reference, mobile), re-rendered only when the light or the LOD changes.
     rs_shadow_map shadow[2];
