@@ -10,12 +10,19 @@
 // floor (under the jaw) is lit by the skin that faces the light.
 uniform vec3 u_env_surround;
 
-// Visibility after interreflections: >= v; per channel, for the cavity's albedo (linear RGB).
+// The fit's cubic coefficients for the cavity's albedo (linear RGB): visibility (a v^2 + b v + c) v.
+void rs_multibounce_fit(vec3 albedo, out vec3 a, out vec3 b, out vec3 c)
+{
+    a = 2.0404 * albedo - 0.3324;
+    b = -4.7951 * albedo + 0.6417;
+    c = 2.7552 * albedo + 0.6903;
+}
+
+// Visibility after interreflections: >= v; per channel.
 vec3 rs_multibounce(float v, vec3 albedo)
 {
-    vec3 a = 2.0404 * albedo - 0.3324;
-    vec3 b = -4.7951 * albedo + 0.6417;
-    vec3 c = 2.7552 * albedo + 0.6903;
+    vec3 a, b, c;
+    rs_multibounce_fit(albedo, a, b, c);
     return max(vec3(v), ((v * a + b) * v + c) * v);
 }
 
@@ -26,10 +33,11 @@ vec3 rs_bounce(float v, vec3 albedo)
 }
 
 // The radiance of that skin in the directions the occlusion hides: rs_bounce over the hidden share (1 - v),
-// by dividing the cubic's (fit - v) by (1 - v) in closed form (its value at v = 1 is 1 within 5e-4, which
-// is dropped), so that it holds up as v -> 1.
+// by dividing the cubic's (fit - v) by (1 - v) in closed form, -v (a (v + 1) + b) (the fit's value at
+// v = 1, a + b + c, is 1 within 5e-4, which is dropped), so that it holds up as v -> 1.
 vec3 rs_hidden_radiance(float v, vec3 albedo)
 {
-    vec3 a = clamp(albedo, 0.0, 1.0);
-    return max(-v * ((2.0404 * a - 0.3324) * (v + 1.0) - 4.7951 * a + 0.6417), 0.0) * u_env_surround;
+    vec3 a, b, c;
+    rs_multibounce_fit(clamp(albedo, 0.0, 1.0), a, b, c);
+    return max(-v * (a * (v + 1.0) + b), 0.0) * u_env_surround;
 }

@@ -396,7 +396,7 @@ void main()
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
             vec3 B = N;  // the bent normal (RT3), where the splats carry one
-            if (u_env_cones > 0.5) {
+            if (u_has_bent > 0.5) {
                 vec2 bt = vec2(t3.x - t3.y, t3.z - t3.w) * (inv / u_bent_scale);
                 vec3 t1, t2;
                 rs_tangents(N, t1, t2);
@@ -408,7 +408,7 @@ void main()
             // half-angle = ao; soft over +-0.1 in cosine: a model of the open directions, not their outline).
             // Outside it the lobe sees the skin around, at the radiance the bounce gives that share.
             float open_cone = 1.0;
-            if (left && u_env_cones > 0.5) {
+            if (left && u_has_bent > 0.5) {
                 float ct = sqrt(max(1.0 - ao, 0.0));
                 open_cone = smoothstep(ct - 0.1, ct + 0.1, dot(Rv, B));
             }

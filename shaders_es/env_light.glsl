@@ -15,7 +15,10 @@ uniform float u_env_m[8];
 uniform int u_env_levels;
 uniform float u_env_scale;          // exposure normalisation of the map (the SH carry theirs)
 uniform highp sampler2D u_spec_lut; // (N.V, m) -> (A, B): the lobe's directional albedo is F0 A + B
-uniform float u_env_cones;          // 1: the splats carry bent normals (RS_SPLAT_FLAG_BENT): rs_env_sky's cones
+#ifndef RS_HAS_BENT_DECLARED  // splat_decode.glsl declares it too
+#define RS_HAS_BENT_DECLARED
+uniform float u_has_bent;           // 1: the splats carry bent normals (RS_SPLAT_FLAG_BENT): rs_env_sky's cones
+#endif
 
 // The SH's irradiance (the environment without its key light and lamps) in the environment's frame, each
 // band scaled: k.x band 0, k.y band 1, k.z band 2 (1, 1, 1: the whole clamped cosine around n).
@@ -43,7 +46,7 @@ vec3 rs_env_irradiance(vec3 n_view) { return rs_env_sh_bands(u_env_from_view * n
 // as before.
 vec3 rs_env_sky(vec3 n_view, vec3 b_view, float ao)
 {
-    if (u_env_cones < 0.5) return rs_env_irradiance(n_view) * ao;
+    if (u_has_bent < 0.5) return rs_env_irradiance(n_view) * ao;
     float c2 = 1.0 - ao;
     return rs_env_sh_bands(u_env_from_view * b_view, vec3(ao, 1.0 - c2 * sqrt(c2), 1.0 - 3.0 * c2 * c2 + 2.0 * c2));
 }

@@ -6,7 +6,10 @@ uniform vec3 u_bbox_min;      // quantization frame, model units
 uniform vec3 u_bbox_step;     // (bbox_max - bbox_min) / 65535
 uniform vec2 u_radius_log;    // radius = u_radius_log.x * exp(u_radius_log.y * q), q = 0..255
 uniform float u_has_ao;       // 1: byte 15 of the record is the splat's ambient occlusion (RS_SPLAT_FLAG_AO)
+#ifndef RS_HAS_BENT_DECLARED  // env_light.glsl declares it too
+#define RS_HAS_BENT_DECLARED
 uniform float u_has_bent;     // 1: the low 6 bits of each half of w.z are the bent normal (RS_SPLAT_FLAG_BENT)
+#endif
 
 struct rs_splat {
     vec3 pos;       // model units

@@ -255,7 +255,7 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
 {
     float key[RS_IRR_KEY];
     irradiance_key(f, key);
-    bool held = r->irr_state > 0 && irradiance_key_holds(key, r->irr_key);
+    bool held = r->irr_state > 0 && r->irr_serial == r->light_serial && irradiance_key_holds(key, r->irr_key);
     bool same_view = memcmp(r->irr_view, f->cam.view, sizeof(mat4)) == 0 &&
                      memcmp(r->irr_proj, f->cam.proj, sizeof(mat4)) == 0;
     r->stats.irradiance_kept = held && (r->irr_state == 2 || same_view);
@@ -304,6 +304,7 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     res = rs_gl_check("render: irradiance pass", err);
     if (res != RS_OK) return res;
     memcpy(r->irr_key, key, sizeof key);
+    r->irr_serial = r->light_serial;
     memcpy(r->irr_view, f->cam.view, sizeof(mat4));
     memcpy(r->irr_proj, f->cam.proj, sizeof(mat4));
     r->irr_state = held ? 2 : 1;

@@ -299,7 +299,7 @@ static void facing_irradiance(const float sh[9][3], const float light_dir[3], co
 rs_result rs_render_set_env(rs_renderer *r, const rs_env *env, rs_error *err)
 {
     r->inc_valid = false;
-    r->irr_state = 0;
+    r->light_serial++;  // the splats' irradiance reads the environment
     if (r->env_tex) glDeleteTextures(1, &r->env_tex);
     r->env_tex = 0;
     memset(&r->env, 0, sizeof r->env);
@@ -371,7 +371,6 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
 {
     bool on = f->env_on;
     glUniform1f(rs_uloc(prog, "u_env_on"), on ? 1.0f : 0.0f);
-    glUniform1f(rs_uloc(prog, "u_env_cones"), (r->cloud->hdr.flags & RS_SPLAT_FLAG_BENT) ? 1.0f : 0.0f);
     rs_render_bind_texture(RS_UNIT_ENV, on ? r->env_tex : 0);
     rs_render_bind_texture(RS_UNIT_SPEC_LUT, on ? r->lut_tex : 0);
     if (!on) return;

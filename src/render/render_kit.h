@@ -226,10 +226,14 @@ struct rs_renderer {
     GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_out;
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;
-    // The irradiance pass's key (render_diffusion.c): the lights in model space, the LOD prefix. Kept E:
-    // 0 none, 1 the splats seen from irr_view / irr_proj only, 2 every splat of the prefix (reused while
-    // the key holds). A shadow map's redraw or a new environment drops it.
+    // What the splats' light reads besides the frame's lights: bumped by every shadow map drawn and every
+    // environment set (render_shadow.c, render_env.c), so that kept irradiance made before is not reused.
+    uint32_t light_serial;
+    // The irradiance pass's key (render_diffusion.c): the lights in model space, the LOD prefix, and
+    // light_serial when it ran. Kept E: 0 none, 1 the splats seen from irr_view / irr_proj only, 2 every
+    // splat of the prefix (reused while the key holds).
     float irr_key[RS_IRR_KEY];
+    uint32_t irr_serial;
     int irr_state;
     mat4 irr_view, irr_proj;
 

@@ -219,7 +219,7 @@ static rs_result lamp_shadows(rs_renderer *r, rs_frame *f, rs_error *err)
             glBindFramebuffer(GL_FRAMEBUFFER, l->fbo);
             glFramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, l->tex, 0, k);
             res = draw_map(r, f, l->size, view, proj, count, scale, err);
-            r->irr_state = 0;  // the splats' irradiance reads the maps
+            r->light_serial++;  // the splats' irradiance reads the maps
             if (res != RS_OK) {
                 memset(l->key[k], 0, sizeof l->key[k]);
                 return res;
@@ -258,7 +258,7 @@ rs_result rs_render_shadow(rs_renderer *r, rs_frame *f, rs_error *err)
     if (!cached) {
         glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
         res = draw_map(r, f, m->size, view, proj, count, scale, err);
-        r->irr_state = 0;  // the splats' irradiance reads the map
+        r->light_serial++;  // the splats' irradiance reads the map
         if (res != RS_OK) return res;
         memcpy(m->key, key, sizeof key);
         m->radius = r->radius_median * scale;

@@ -150,7 +150,7 @@ void rs_splat_quantize_normals(rs_splat_cloud *c, int bits)
     if (bits == 16) return;
     int step = 1 << (16 - bits);
     for (uint32_t i = 0; i < c->hdr.count; i++) {
-        uint32_t keep = bent ? c->packed[i].w[2] & 0x003f003fu : 0u;
+        uint32_t keep = c->packed[i].w[2] & ~rs_splat_normal_mask(c->hdr.flags);
         c->packed[i].w[2] = encode_normal_lattice(c->normal[i], step);
         rs_splat_decode_normal(c->packed[i].w[2], c->normal[i]);
         c->packed[i].w[2] |= keep;
@@ -547,7 +547,8 @@ static rs_result fill_header(rs_splat_header *h, const rs_splat_header *in, rs_e
     if (!in) in = &none;
     memset(h, 0, sizeof *h);
     if (in->flags & RS_SPLAT_FLAG_BENT)
-        return rs_fail(err, RS_ERR_ARG, "%s: flags: RS_SPLAT_FLAG_BENT comes with the bent normals (rs_splat_set_bent)", who);
+        return rs_fail(err, RS_ERR_ARG, "%s: flags: RS_SPLAT_FLAG_BENT comes with the bent normals (rs_splat_set_bent)",
+                       who);
     if (in->flags & ~RS_SPLAT_FLAG_AO) return rs_fail(err, RS_ERR_ARG, "%s: flags: 0x%08x, unknown bits", who, in->flags);
     if (in->lod_count > RS_SPLAT_MAX_LODS)
         return rs_fail(err, RS_ERR_ARG, "%s: lod_count: %u, at most %d", who, in->lod_count, RS_SPLAT_MAX_LODS);
@@ -742,15 +743,16 @@ rs_result rs_splat_set_bent(rs_splat_cloud *c, const float (*bent)[3], rs_error 
 {
     if (!bent) {
         if (c->hdr.flags & RS_SPLAT_FLAG_BENT)
-            for (uint32_t i = 0; i < c->hdr.count; i++) c->packed[i].w[2] &= 0xffc0ffc0u;
+            for (uint32_t i = 0; i < c->hdr.count; i++) c->packed[i].w[2] &= rs_splat_normal_mask(c->hdr.flags);
         c->hdr.flags &= ~RS_SPLAT_FLAG_BENT;
         return RS_OK;
     }
     if (!(c->hdr.flags & RS_SPLAT_FLAG_AO))
         return rs_fail(err, RS_ERR_ARG, "bent normals: the cloud has no ambient occlusion (rs_splat_set_ao first)");
     if (!(c->hdr.flags & RS_SPLAT_FLAG_BENT)) rs_splat_quantize_normals(c, 10);
+    const uint32_t mask = rs_splat_normal_mask(RS_SPLAT_FLAG_BENT);
     for (uint32_t i = 0; i < c->hdr.count; i++)
-        c->packed[i].w[2] = (c->packed[i].w[2] & 0xffc0ffc0u) | encode_bent(bent[i], c->normal[i]);
+        c->packed[i].w[2] = (c->packed[i].w[2] & mask) | encode_bent(bent[i], c->normal[i]);
     c->hdr.flags |= RS_SPLAT_FLAG_BENT;
     return RS_OK;
 }
