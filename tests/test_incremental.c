@@ -152,6 +152,16 @@ static void test_kept_irradiance(void)
     ok = ok && kept_frame(r, &v, env, false, "environment, left profile");
     rs_render_invalidate(r);  // a full frame, not an incremental one (which runs no stage 4)
     ok = ok && kept_frame(r, &v, env, true, "environment, left profile again");
+    // Another kernel count in the same view: kept only while its levels reach no farther than the pass
+    // that computed the view's splats (on this face the widest level is the splats' floor either way).
+    for (int k = 2; k <= 4; k += 2) {
+        v.kernel_count = k;
+        rs_render_invalidate(r);
+        char what[64];
+        snprintf(what, sizeof what, "environment, left profile, %d Gaussians", k);
+        ok = ok && kept_frame(r, &v, env, true, what);
+    }
+    v.kernel_count = 0;
     v.yaw_deg = 70;
     ok = ok && kept_frame(r, &v, env, false, "environment, right profile (lights held: every splat)");
     v.yaw_deg = 10, v.pitch_deg = -15;

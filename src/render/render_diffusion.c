@@ -253,13 +253,6 @@ static bool irradiance_key_holds(const float a[RS_IRR_KEY], const float b[RS_IRR
 static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                                  rs_error *err)
 {
-    float key[RS_IRR_KEY];
-    irradiance_key(f, key);
-    bool held = r->irr_state > 0 && r->irr_serial == r->light_serial && irradiance_key_holds(key, r->irr_key);
-    bool same_view = memcmp(r->irr_view, f->cam.view, sizeof(mat4)) == 0 &&
-                     memcmp(r->irr_proj, f->cam.proj, sizeof(mat4)) == 0;
-    r->stats.irradiance_kept = held && (r->irr_state == 2 || same_view);
-    if (r->stats.irradiance_kept) return RS_OK;
     // The farthest any level's kernel reaches (its sigma, or the floor of the widest splat of its prefix,
     // or of a pixel at the far end of the cloud): splats deeper behind the visible surface or farther
     // outside the view than this reach no pixel, so their shadow lookup is skipped -- unless the result
@@ -270,6 +263,15 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
         float px = f->cam.px_size * (float)levels[i].res_div * f->cam.far_z;
         reach = fmaxf(reach, 3.0f * fmaxf(levels[i].sigma, 0.5f * fmaxf(rmax, px)));
     }
+    float key[RS_IRR_KEY];
+    irradiance_key(f, key);
+    bool held = r->irr_state > 0 && r->irr_serial == r->light_serial && irradiance_key_holds(key, r->irr_key);
+    // The same view may reuse a pass that skipped splats only if its levels reach no farther (another
+    // kernel count may draw a wider level; the key does not hold it).
+    bool same_view = memcmp(r->irr_view, f->cam.view, sizeof(mat4)) == 0 &&
+                     memcmp(r->irr_proj, f->cam.proj, sizeof(mat4)) == 0 && reach <= r->irr_reach;
+    r->stats.irradiance_kept = held && (r->irr_state == 2 || same_view);
+    if (r->stats.irradiance_kept) return RS_OK;
     if (held) reach = FLT_MAX;
     r->irr_state = 0;
     GLuint prog;
@@ -307,6 +309,7 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     r->irr_serial = r->light_serial;
     memcpy(r->irr_view, f->cam.view, sizeof(mat4));
     memcpy(r->irr_proj, f->cam.proj, sizeof(mat4));
+    r->irr_reach = reach;
     r->irr_state = held ? 2 : 1;
     return RS_OK;
 }

@@ -230,9 +230,9 @@ struct rs_renderer {
     // environment set (render_shadow.c, render_env.c), so that kept irradiance made before is not reused.
     uint32_t light_serial;
     // The irradiance pass's key (render_diffusion.c): the lights in model space, the LOD prefix, and
-    // light_serial when it ran. Kept E: 0 none, 1 the splats seen from irr_view / irr_proj only, 2 every
-    // splat of the prefix (reused while the key holds).
-    float irr_key[RS_IRR_KEY];
+    // light_serial when it ran. Kept E: 0 none, 1 the splats within irr_reach of what irr_view / irr_proj
+    // see, 2 every splat of the prefix (reused while the key holds).
+    float irr_key[RS_IRR_KEY], irr_reach;
     uint32_t irr_serial;
     int irr_state;
     mat4 irr_view, irr_proj;
