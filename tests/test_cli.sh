@@ -89,7 +89,7 @@ no_file cli_fifo_input_leaves_no_output "$tmp/h.png"
 expect cli_size_does_not_wrap 2 "--size: expected WxH" "$rouge" render "$face" -o "$tmp/i.png" --size 4294967312x16
 no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
 # Memory: the frame size is bounded by what its render targets cost, said in the error.
-expect cli_size_bounded_by_target_memory 1 "needs about 3.9 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
+expect cli_size_bounded_by_target_memory 1 "needs about 4.0 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
 no_file cli_size_memory_leaves_no_output "$tmp/m.png"
 expect cli_pan_out_of_range 2 "--pan: expected X,Y within -2..2" "$rouge" render "$face" -o "$tmp/p.png" --pan 3,0
 expect cli_target_unknown_region_lists_them 2 "no region 'elbow' in this face (it has other|cheek|nose|forehead|lips|eyelid|brow)" \

@@ -645,8 +645,10 @@ static void test_brush_sizes_grow_painted_area_quadratically(void)
 // 15 %), and nothing changes outside the painted mask (union over the shades of the pixels whose albedo
 // or specular image changed): the albedo is not diffused in this pipeline (D is irradiance), so makeup
 // cannot spread. The masks come from 8-bit images, so an albedo change under half a level there can
-// still round the other way in the lit image: pixels within 2 px of the mask may differ by 1 level,
-// pixels farther away must be identical.
+// still round the other way in the lit image: pixels within 3 px of the mask may differ by 1 level,
+// pixels farther away must be identical (2 px until the visibility pass pushed disks' outer parts back,
+// which lets more of a surface's faint disk rims blend in the gaps between centres; then one pixel
+// 3.2 px from the mask differed by a level in shade 3).
 static void test_foundation_shades_darken_only_the_painted_skin(void)
 {
     if (!need_face()) return;
@@ -672,7 +674,7 @@ static void test_foundation_shades_darken_only_the_painted_skin(void)
     if (ok) {
         double l0 = mean_luminance(&bare, mask), l[3];
         note("foundation mask %d px", mask_count(mask));
-        // Outside the mask: the 2-pixel rim may round differently by a level, farther out nothing moves.
+        // Outside the mask: the 3-pixel rim may round differently by a level, farther out nothing moves.
         int outside = 0, worst = 0, rim = 0, worst_rim = 0;
         for (int i = 0; i < 3; i++) {
             l[i] = mean_luminance(&full[i], mask);
@@ -680,7 +682,7 @@ static void test_foundation_shades_darken_only_the_painted_skin(void)
                 for (int x = 0; x < SIZE; x++) {
                     if (mask[y * SIZE + x]) continue;
                     int d = max_channel_diff(&full[i], &bare, x, y);
-                    if (near_mask(mask, x, y, 2)) {
+                    if (near_mask(mask, x, y, 3)) {
                         rim += d > 0;
                         worst_rim = RS_MAX(worst_rim, d);
                     } else {

@@ -130,6 +130,81 @@ static void test_coarse_lod_and_side_view_have_no_holes(void)
     rs_image_free(&img);
 }
 
+// A fold (the lower lip over the chin's hollow): sheet A (green) ends at x = 0 over sheet B (red), which
+// lies 1.5 eps behind it, both sampled every S with the head's radius-to-spacing ratio (0.95 / 0.62 mm).
+// A's last disks overhang its sampled extent by their radius, 1.5 S, and on the face their rims drew pale
+// scallops over the hollow. Seen head-on in the albedo view, each row's switch from A to B must lie nearer
+// the sampled edge (S / 2, halfway to the next sample) than the overhang's end: 0.96 S (before: 1.59 S,
+// past the disks' rim, on every row).
+#define FOLD_S 0.62f
+#define FOLD_R (1.53f * FOLD_S)
+static rs_splat_cloud *make_fold(void)
+{
+    enum { NX = 41, NY = 31 };
+    rs_splat *s = calloc(2 * NX * NY, sizeof *s);
+    if (!s) return NULL;
+    int n = 0;
+    // eps is half the median radius (render_view.c); B 1.5 eps behind: a separate layer, within the push.
+    float depth = 0.75f * FOLD_R;
+    for (int sheet = 0; sheet < 2; sheet++)
+        for (int j = 0; j < NY; j++)
+            for (int i = 0; i < NX; i++) {
+                float x = (float)(i - (NX - 1) / 2) * FOLD_S;
+                if (sheet == 0 && x > 0.0f) continue;
+                rs_splat *p = &s[n++];
+                p->pos[0] = x, p->pos[1] = (float)(j - (NY - 1) / 2) * FOLD_S, p->pos[2] = sheet ? -depth : 0.0f;
+                p->normal[2] = 1.0f;
+                p->radius = FOLD_R;
+                p->rgb[sheet ? 0 : 1] = 200;
+            }
+    rs_splat_header h = {.mm_per_unit = 1.0f, .forward = {0, 0, 1}, .up = {0, 1, 0},
+                         .face_height = (float)NY * FOLD_S, .region_count = RS_REGION_BUILTIN_COUNT};
+    rs_splat_default_regions(&h);
+    rs_splat_cloud *c = NULL;
+    rs_error err = {0};
+    RS_CHECK(rs_splat_create(s, (uint32_t)n, &h, &c, &err) == RS_OK, "fold: %s", err.msg);
+    free(s);
+    return c;
+}
+
+static void test_fold_edge_shows_the_surface_behind(void)
+{
+    rs_splat_cloud *fold = make_fold();
+    rs_renderer *r = NULL;
+    rs_error err = {0};
+    rs_render_desc desc = {.cloud = fold, .caps = rs_gl_get_caps(tf.gl)};
+    if (!fold || !RS_CHECK(rs_render_create(&desc, &r, &err) == RS_OK, "%s", err.msg)) {
+        rs_splat_destroy(fold);
+        return;
+    }
+    rs_view v = test_view(RS_MODE_ALBEDO);
+    v.max_splats = 0;
+    rs_image img = {0};
+    float edge[3] = {0}, next[3] = {FOLD_S, 0, 0}, e_px[2], n_px[2];
+    if (rs_test_render(r, &v, &img) &&
+        RS_CHECK(rs_render_project(r, &v, edge, e_px) && rs_render_project(r, &v, next, n_px), "projection")) {
+        double per_s = n_px[0] - e_px[0], sum = 0, worst = 0;
+        int rows = 0;
+        int y0 = RS_MAX((int)(e_px[1] - 5 * per_s), 0), y1 = RS_MIN((int)(e_px[1] + 5 * per_s), img.height - 1);
+        for (int y = y0; y <= y1; y++) {
+            int x = RS_MAX((int)e_px[0], 0);
+            while (x < img.width - 1 && px(&img, x, y)[1] >= px(&img, x, y)[0]) x++;
+            double at = (x + 0.5 - e_px[0]) / per_s;
+            sum += at, worst = fmax(worst, at), rows++;
+        }
+        double mean = rows ? sum / rows : 0;
+        printf("# fold: A gives way to B %.2f S past A's last samples on average, %.2f at most (%.1f px per S; "
+               "sampled edge 0.5 S, disks' rim %.2f S)\n", mean, worst, per_s, FOLD_R / FOLD_S);
+        RS_CHECK(per_s > 4.0, "the fold is too small on screen (%.1f px per sample)", per_s);
+        double limit = 0.5 * (0.5 + FOLD_R / FOLD_S);
+        if (!RS_CHECK(mean < limit, "A overhangs B by %.2f S (its rim: %.2f S)", mean, FOLD_R / FOLD_S))
+            rs_test_save("render_fold", &img);
+    }
+    rs_image_free(&img);
+    rs_render_destroy(r);
+    rs_splat_destroy(fold);
+}
+
 static void test_points_and_quads_give_the_same_image(void)
 {
     if (!need_face()) return;
@@ -638,6 +713,7 @@ int main(int argc, char **argv)
     RS_RUN(test_visibility_leaves_no_holes_inside_silhouette);
     RS_RUN(test_coarse_lod_and_side_view_have_no_holes);
     RS_RUN(test_points_and_quads_give_the_same_image);
+    RS_RUN(test_fold_edge_shows_the_surface_behind);
     RS_RUN(test_specular_energy_doubles_with_rho_s);
     RS_RUN(test_composite_is_albedo_times_diffuse_plus_specular);
     RS_RUN(test_rgba8_fallback_is_close_to_float_targets);

@@ -151,12 +151,12 @@ static void release_targets(rs_renderer *r)
 {
     GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_diffuse, r->fbo_out};
     glDeleteFramebuffers((GLsizei)RS_COUNT_OF(fbos), fbos);
-    GLuint texs[] = {r->depth_tex, r->diffuse_tex, r->out_tex};
+    GLuint texs[] = {r->depth_tex, r->push_tex, r->diffuse_tex, r->out_tex};
     glDeleteTextures((GLsizei)RS_COUNT_OF(texs), texs);
     glDeleteTextures(RS_ATTR_TARGETS, r->attr_tex);
     rs_render_level_release(r);
     r->fbo_vis = r->fbo_attr = r->fbo_diffuse = r->fbo_out = 0;
-    r->depth_tex = 0;
+    r->depth_tex = r->push_tex = 0;
     memset(r->attr_tex, 0, sizeof r->attr_tex);
     r->diffuse_tex = r->out_tex = 0;
     r->tw = r->th = 0;
@@ -200,13 +200,13 @@ static GLuint fbo_with(const GLuint *colour, int ncolour, GLuint depth)
     return fbo;
 }
 
-// Render targets of a w x h frame: depth, four attribute targets, diffuse, output, the reduced-resolution
-// diffusion levels (at most 4/3 of one accumulation target) and the ID buffer (R32UI + depth). llvmpipe keeps
-// all of it in CPU memory, so this is what a frame size costs the machine.
+// Render targets of a w x h frame: depth and its push, four attribute targets, diffuse, output, the
+// reduced-resolution diffusion levels (at most 4/3 of one accumulation target) and the ID buffer (R32UI +
+// depth). llvmpipe keeps all of it in CPU memory, so this is what a frame size costs the machine.
 static double target_estimate(int w, int h, bool float_rt)
 {
     double px = (double)w * h, acc = float_rt ? 8 : 4;
-    return px * (4 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + acc * 4.0 / 3.0 + 8);
+    return px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + acc * 4.0 / 3.0 + 8);
 }
 
 static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
@@ -221,6 +221,7 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
     release_targets(r);
     GLenum acc = r->float_rt ? GL_RGBA16F : GL_RGBA8;
     r->depth_tex = rs_render_texture(GL_DEPTH_COMPONENT32F, w, h);
+    r->push_tex = rs_render_texture(GL_R8, w, h);
     // The bent normal's target is RGBA8 whatever the others are (attribute.frag.glsl).
     for (int i = 0; i < RS_ATTR_TARGETS; i++) r->attr_tex[i] = rs_render_texture(i < 3 ? acc : GL_RGBA8, w, h);
     r->diffuse_tex = rs_render_texture(acc, w, h);
@@ -234,7 +235,7 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
         const char *what;
         const char *fmt;
     } t[] = {
-        {&r->fbo_vis, NULL, 0, r->depth_tex, "visibility target", "DEPTH_COMPONENT32F"},
+        {&r->fbo_vis, &r->push_tex, 1, r->depth_tex, "visibility target", "DEPTH_COMPONENT32F + R8"},
         {&r->fbo_attr, r->attr_tex, RS_ATTR_TARGETS, r->depth_tex, "attribute targets", acc_name},
         {&r->fbo_diffuse, &r->diffuse_tex, 1, 0, "diffuse target", acc_name},
         {&r->fbo_out, &r->out_tex, 1, 0, "output target", "RGBA8"},
@@ -259,7 +260,7 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
 static size_t target_bytes(const rs_renderer *r)
 {
     size_t px = (size_t)r->tw * (size_t)r->th, acc = r->float_rt ? 8 : 4;
-    size_t bytes = px * (4 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4);  // depth, attributes, D, out
+    size_t bytes = px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4);  // depth, push, attributes, D, out
     for (int i = 0; i < RS_LEVEL_DIVS; i++)
         if (r->level_tex[i]) bytes += px * acc >> (2 * i);
     return bytes;

@@ -62,6 +62,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform1f(rs_uloc(prog, "u_bent_scale"), r->float_rt ? RS_ATTR_WEIGHT_SCALE_RGBA8 : 1.0f);
     rs_render_shadow_uniforms(r, f, prog);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+    rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
     for (int i = 0; i < RS_ATTR_TARGETS; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
     rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
     rs_render_fine_uniforms(r, f, prog);

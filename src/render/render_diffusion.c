@@ -212,6 +212,7 @@ static rs_result draw_level(rs_renderer *r, const rs_frame *f, const rs_diffusio
     glUniform1f(rs_uloc(prog, "u_eps"), f->eps);
     glUniform2f(rs_uloc(prog, "u_acc_scale"), e_scale, r->float_rt ? 1.0f : FALLBACK_WEIGHT_SCALE);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+    rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
     rs_render_draw_splats(r, l->count, l->quads);
     return RS_OK;
 }
@@ -370,6 +371,7 @@ rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffus
         glUniform1f(rs_uloc(resolve, "u_min_weight"), r->float_rt ? 0.0f : 16.0f / 255.0f);
         rs_render_bind_texture(RS_UNIT_LEVEL, r->level_tex[div_index(levels[i].res_div)]);
         rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+        rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
         glBindVertexArray(r->vao_empty);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         if (r->time_stages && i < (int)RS_COUNT_OF(r->stats.level_ms)) {

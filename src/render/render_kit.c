@@ -86,6 +86,7 @@ rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *ou
     glUniform3fv(rs_uloc(p, "u_bbox_step"), 1, step);
     glUniform2f(rs_uloc(p, "u_radius_log"), h->radius_min, logf(h->radius_max / h->radius_min) / 255.0f);
     glUniform1i(rs_uloc(p, "u_depth"), RS_UNIT_DEPTH);
+    glUniform1i(rs_uloc(p, "u_push"), RS_UNIT_PUSH);
     glUniform1i(rs_uloc(p, "u_shadow_map"), RS_UNIT_SHADOW);
     glUniform1i(rs_uloc(p, "u_lamp_shadow_map"), RS_UNIT_LAMP_SHADOW);
     glUniform1i(rs_uloc(p, "u_attr0"), RS_UNIT_ATTR0);

@@ -38,6 +38,7 @@ typedef enum rs_prog {
 // Fixed texture units (set once per program when it is linked).
 enum {
     RS_UNIT_DEPTH = 0,   // visibility depth (u_depth)
+    RS_UNIT_PUSH,        // how far the visibility pass pushed each pixel's depth back (u_push)
     RS_UNIT_SHADOW,      // shadow map (u_shadow_map, compare mode)
     RS_UNIT_ATTR0,       // attribute targets (u_attr0..3)
     RS_UNIT_ATTR1,
@@ -222,7 +223,7 @@ struct rs_renderer {
 
     // Frame targets (width x height).
     int tw, th;
-    GLuint depth_tex, attr_tex[RS_ATTR_TARGETS], diffuse_tex, out_tex;
+    GLuint depth_tex, push_tex, attr_tex[RS_ATTR_TARGETS], diffuse_tex, out_tex;
     GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_out;
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;

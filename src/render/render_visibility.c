@@ -1,6 +1,8 @@
-// render_visibility.c — stage 2, visibility splatting (Botsch et al. 2005; paper Fig. 2): a depth-only pass
+// render_visibility.c — stage 2, visibility splatting (Botsch et al. 2005; paper Fig. 2): a depth pass
 // of the splats as disks (per-pixel ray-disk intersection), each hit pushed back by frame->eps along its
-// view ray, so that stage 3 blends every splat of the front surface layer and nothing behind it.
+// view ray, so that stage 3 blends every splat of the front surface layer and nothing behind it. The push
+// grows towards the disk's rim (visibility.frag.glsl); an R8 target keeps each pixel's, so that the stages
+// that reconstruct the visible point from the depth undo it exactly.
 #include "render/render_stages.h"
 
 // Splats facing away beyond this are dropped (their front-facing neighbours cover the silhouette).
@@ -19,7 +21,8 @@ rs_result rs_render_visibility(rs_renderer *r, const rs_frame *f, rs_error *err)
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glClearDepthf(1.0f);
-    glClear(GL_DEPTH_BUFFER_BIT);
+    glClearColor(0.0f, 0.0f, 0.0f, 0.0f);
+    glClear(GL_DEPTH_BUFFER_BIT | GL_COLOR_BUFFER_BIT);
     glUseProgram(prog);
     rs_render_splat_uniforms(prog, cam->view, cam->proj, cam->inv_proj, cam->width, cam->height, true,
                              f->radius_scale, CULL_COS, r->caps.point_size_max);
