@@ -83,14 +83,14 @@ static const measured was[] = {
     // 0.99 -> 0.87 / 0.96; bands within 0.002. Daylight front's band under the jaw stays 0.991: at 768 px
     // the reference's skin there is lit 3x more by its specular (its glossy passes: reflecting the neck)
     // while rouge's reflection march and bent cone both find that direction open.
-    {"studio", "front", 1.29, {1.013, 1.039, 0.974, 1.015, 1.007}, 1.130, 0.17},
-    {"studio", "threequarter", 1.61, {1.006, 1.055, 0.983, 1.025, 0.999}, 1.003, 0.08},
-    {"daylight", "front", 1.12, {0.990, 1.053, 1.035, 1.017, 1.031}, 0.997, 0.00},
-    {"daylight", "threequarter", 1.15, {0.967, 1.054, 0.991, 1.007, 1.019}, 1.002, 0.00},
-    {"office", "front", 1.44, {1.031, 1.044, 1.055, 1.008, 0.988}, 1.054, 0.00},
-    {"office", "threequarter", 1.37, {0.973, 1.048, 1.022, 0.995, 0.960}, 1.059, 0.01},
-    {"sunset", "front", 0.87, {1.001, 1.061, 1.017, 1.019, 1.027}, 1.014, 0.01},
-    {"sunset", "threequarter", 0.96, {1.004, 1.062, 0.997, 1.010, 1.021}, 1.007, 0.00},
+    {"studio", "front", 1.30, {1.012, 1.043, 0.967, 1.015, 1.009}, 1.135, 0.21},
+    {"studio", "threequarter", 1.62, {1.005, 1.057, 0.982, 1.023, 0.998}, 1.004, 0.08},
+    {"daylight", "front", 1.13, {0.989, 1.058, 1.032, 1.018, 1.032}, 0.998, 0.00},
+    {"daylight", "threequarter", 1.15, {0.966, 1.057, 0.992, 1.006, 1.018}, 1.002, 0.00},
+    {"office", "front", 1.45, {1.030, 1.050, 1.051, 1.009, 0.989}, 1.055, 0.00},
+    {"office", "threequarter", 1.37, {0.971, 1.053, 1.022, 0.995, 0.960}, 1.060, 0.00},
+    {"sunset", "front", 0.88, {1.000, 1.065, 1.016, 1.019, 1.027}, 1.015, 0.01},
+    {"sunset", "threequarter", 0.97, {1.003, 1.064, 0.998, 1.009, 1.019}, 1.007, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
