@@ -22,6 +22,7 @@ static const char *const mode_names[RS_MODE_COUNT] = {"full", "albedo", "diffuse
 static const opt opts[] = {
     {"-o", OPT_PATH, "PNG", "output image (render); written atomically", 0, 0},
     {"--size", OPT_SIZE, "WxH", "image size in pixels (default 512x512; 16..8192)", 16, RS_VIEW_MAX_SIZE_PX},
+    {"--supersample", OPT_INT, "N", "render: draw N x N samples per pixel and average them (1..4; smooth edges for stills)", 1, 4},
     {"--yaw", OPT_FLOAT, "DEG", "camera yaw around the face (0 = frontal, + = towards the subject's left)", -360, 360},
     {"--pitch", OPT_FLOAT, "DEG", "camera pitch (+ = from above)", -89, 89},
     {"--zoom", OPT_FLOAT, "Z", "1 = face fills the view; 2 = twice as close", 0.1f, 20},
@@ -171,6 +172,7 @@ static rs_result apply(const opt *o, const char *v, rs_cli *c, rs_error *err)
     else if (!strcmp(n, "--fullscreen")) c->fullscreen = true;
     else if (!strcmp(n, "--events")) c->events = v;
     else if (!strcmp(n, "--bench-orbit")) c->bench_orbit = (int)f;
+    else if (!strcmp(n, "--supersample")) c->supersample = (int)f;
     return RS_OK;
 }
 

@@ -27,6 +27,7 @@ typedef struct rs_cli {
     const char *looks;      // --looks DIR: the viewer's look library (NULL: rs_looklib_default_dir)
     const char *events;     // --events FILE: viewer replays an event script (tests, demos)
     int bench_orbit;        // --bench-orbit N: viewer orbits N frames, prints frame times, exits (0: off)
+    int supersample;        // --supersample N: render draws N x N samples per pixel (0 or 1: one)
     rs_view view;
     bool view_set[4];       // which of yaw/pitch/zoom/fov were given (strokes files carry a view)
     bool size_set;          // --size given (the viewer's window size; default 1024x768)

@@ -91,6 +91,16 @@ no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
 # Memory: the frame size is bounded by what its render targets cost, said in the error.
 expect cli_size_bounded_by_target_memory 1 "needs about 4.0 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
 no_file cli_size_memory_leaves_no_output "$tmp/m.png"
+expect cli_supersample_out_of_range 2 "--supersample: 5 is out of range 1..4" "$rouge" render "$face" -o "$tmp/s.png" --supersample 5
+expect cli_supersample_over_max_size 2 "--supersample 3: 4000x4000 would be drawn at 12000x12000" \
+    "$rouge" render "$face" -o "$tmp/s.png" --size 4000x4000 --supersample 3 --mode albedo
+no_file cli_supersample_over_max_size_leaves_no_output "$tmp/s.png"
+# A supersampled still has the size asked for and the plain render's picture, its edges averaged (not equal).
+if "$rouge" render "$face" -o "$tmp/s1.png" --size 48x40 --max-splats 2000 --mode albedo >/dev/null 2>"$tmp/err" &&
+    "$rouge" render "$face" -o "$tmp/s2.png" --size 48x40 --max-splats 2000 --mode albedo --supersample 2 >/dev/null 2>>"$tmp/err" &&
+    "$build/rouge-imgdiff" "$tmp/s1.png" "$tmp/s2.png" --min-psnr 20 >"$tmp/out" 2>>"$tmp/err" &&
+    ! grep -q "psnr_db inf" "$tmp/out"; then echo "ok - cli_supersample_keeps_size_and_picture"
+else echo "FAIL - cli_supersample_keeps_size_and_picture: $(head -c 300 "$tmp/err") $(head -c 200 "$tmp/out")"; fi
 expect cli_pan_out_of_range 2 "--pan: expected X,Y within -2..2" "$rouge" render "$face" -o "$tmp/p.png" --pan 3,0
 expect cli_target_unknown_region_lists_them 2 "no region 'elbow' in this face (it has other|cheek|nose|forehead|lips|eyelid|brow)" \
     "$rouge" render "$face" -o "$tmp/p.png" --size 32x32 --max-splats 2000 --target elbow

@@ -499,6 +499,29 @@ static void test_diff_amplifies_by_four_and_clamps(void)
     rs_image_free(&d);
 }
 
+// A 2x2 block of black and white averages to half the light (sRGB 188, not 128: a box filter on the encoded
+// values would draw every anti-aliased edge too dark), a uniform block to itself, alpha as is; a size that
+// is not a multiple of the factor is refused with both numbers.
+static void test_downsample_averages_light_not_codes(void)
+{
+    rs_error err = {0};
+    rs_image a = {0}, d = {0};
+    RS_REQUIRE(rs_image_create(4, 2, 4, &a, &err) == RS_OK, "setup");
+    const uint8_t px[32] = {0, 0, 0, 0,        255, 255, 255, 255, 77, 77, 77, 10, 77, 77, 77, 10,
+                            255, 255, 255, 255, 0, 0, 0, 0,         77, 77, 77, 30, 77, 77, 77, 30};
+    memcpy(a.pixels, px, sizeof px);
+    RS_REQUIRE(rs_image_downsample(&a, 2, &d, &err) == RS_OK, "%s", err.msg);
+    RS_CHECK(d.width == 2 && d.height == 1 && d.channels == 4, "size %dx%dx%d", d.width, d.height, d.channels);
+    const uint8_t want[8] = {188, 188, 188, 128, 77, 77, 77, 20};
+    RS_CHECK(memcmp(d.pixels, want, sizeof want) == 0, "got %d %d %d %d / %d %d %d %d", d.pixels[0], d.pixels[1],
+             d.pixels[2], d.pixels[3], d.pixels[4], d.pixels[5], d.pixels[6], d.pixels[7]);
+    rs_image_free(&d);
+    RS_CHECK(rs_image_downsample(&a, 3, &d, &err) != RS_OK && strstr(err.msg, "4x2") && strstr(err.msg, "3"),
+             "a 4x2 image by 3: '%s'", err.msg);
+    RS_CHECK(d.pixels == NULL, "an image was made on failure");
+    rs_image_free(&a);
+}
+
 // ---------------------------------------------------------------------------------------------------
 // PNG I/O
 
@@ -762,6 +785,7 @@ int main(int argc, char **argv)
 {
     rs_test_init(argc, argv);
     RS_RUN(test_create_rejects_bad_sizes_and_channels);
+    RS_RUN(test_downsample_averages_light_not_codes);
     RS_RUN(test_identical_images_give_infinite_psnr_and_ssim_exactly_one);
     RS_RUN(test_uniform_offset_gives_exact_psnr_and_abs_errors);
     RS_RUN(test_one_changed_pixel_gives_frac_over_of_one_pixel);

@@ -35,6 +35,31 @@ rs_result rs_image_create(int width, int height, int channels, rs_image *out, rs
     return RS_OK;
 }
 
+rs_result rs_image_downsample(const rs_image *in, int factor, rs_image *out, rs_error *err)
+{
+    if (factor < 1 || !in->pixels || in->width % factor || in->height % factor)
+        return rs_fail(err, RS_ERR_ARG, "downsample: %dx%d is not a multiple of %d", in->width, in->height, factor);
+    rs_result r = rs_image_create(in->width / factor, in->height / factor, in->channels, out, err);
+    if (r) return r;
+    float lin[256];
+    for (int i = 0; i < 256; i++) lin[i] = rs_srgb_to_linear((float)i / 255.0f);
+    int ch = in->channels;
+    float inv = 1.0f / (float)(factor * factor);
+    for (int y = 0; y < out->height; y++)
+        for (int x = 0; x < out->width; x++) {
+            float sum[4] = {0};
+            for (int dy = 0; dy < factor; dy++) {
+                const uint8_t *p = in->pixels + (((size_t)y * factor + dy) * in->width + (size_t)x * factor) * ch;
+                for (int dx = 0; dx < factor; dx++, p += ch)
+                    for (int c = 0; c < ch; c++) sum[c] += c < 3 ? lin[p[c]] : (float)p[c];
+            }
+            uint8_t *o = out->pixels + ((size_t)y * out->width + x) * ch;
+            for (int c = 0; c < ch; c++)
+                o[c] = (uint8_t)lrintf(c < 3 ? 255.0f * rs_linear_to_srgb(sum[c] * inv) : sum[c] * inv);
+        }
+    return RS_OK;
+}
+
 void rs_image_free(rs_image *img)
 {
     if (!img) return;

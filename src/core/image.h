@@ -44,6 +44,11 @@ rs_result rs_image_read_png(const char *path, rs_image *out, rs_error *err);
 rs_result rs_image_read_png_memory(const void *data, size_t len, const char *name, rs_image *out, rs_error *err);
 rs_result rs_image_write_png(const char *path, const rs_image *img, rs_error *err);
 
+// in reduced by a whole factor in each direction (its size must be a multiple of it): each out pixel the
+// mean of a factor x factor block, in linear light (sRGB decoded, averaged, encoded; alpha averaged as is).
+// Supersampled renders use it, so an edge's pixel shows the share of each side a camera would.
+rs_result rs_image_downsample(const rs_image *in, int factor, rs_image *out, rs_error *err);
+
 // a and b must have the same size; alpha is ignored. `threshold` feeds frac_over.
 rs_result rs_image_compare(const rs_image *a, const rs_image *b, int threshold, rs_image_metrics *out,
                            rs_error *err);
