@@ -121,14 +121,7 @@ static rs_result check_inputs(const char *face, const char *look, rs_error *err)
 static rouge_result render_supersampled(rouge_face *face, int n, rs_image *out, rouge_error *e)
 {
     rouge_view v = rouge_face_get_view(face);
-    int w = v.width ? v.width : 512, h = v.height ? v.height : 512;
-    if (w * n > RS_VIEW_MAX_SIZE_PX || h * n > RS_VIEW_MAX_SIZE_PX) {
-        e->code = ROUGE_ERR_ARG;
-        snprintf(e->msg, sizeof e->msg, "--supersample %d: %dx%d would be drawn at %dx%d, over %d pixels a side "
-                 "(use a smaller --size or N)", n, w, h, w * n, h * n, RS_VIEW_MAX_SIZE_PX);
-        return e->code;
-    }
-    v.width = w * n, v.height = h * n;
+    v.width *= n, v.height *= n;
     rouge_result r = rouge_face_set_view(face, &v, e);
     if (!r) r = rouge_face_render(face, e);
     rs_image big = {0};
@@ -158,6 +151,10 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
     if (rs_same_file(cli->save_look, path) || rs_same_file(cli->save_look, cli->strokes))
         return rs_fail(err, RS_ERR_ARG, "--save-look %s is an input of this render; refusing to overwrite it",
                        cli->save_look);
+    int w = cli->view.width, h = cli->view.height, n = cli->supersample;
+    if (n > 1 && (w * n > RS_VIEW_MAX_SIZE_PX || h * n > RS_VIEW_MAX_SIZE_PX))
+        return rs_fail(err, RS_ERR_ARG, "--supersample %d: %dx%d would be drawn at %dx%d, over %d pixels a side "
+                       "(use a smaller --size or N)", n, w, h, w * n, h * n, RS_VIEW_MAX_SIZE_PX);
     rs_result rr = check_inputs(path, cli->look, err);
     if (rr) return rr;
     rs_gl_context *gl = NULL;
