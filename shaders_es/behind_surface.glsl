@@ -3,8 +3,11 @@
 // both so that they agree on which splats those are.
 //
 // View-space point c; proj / inv_proj: the camera's; depth: the visibility pass's depth (the view's size),
-// pushed back by eps along the view ray. -1 when c is not behind it (off screen, background).
-float rs_behind_visible(vec3 c, mat4 proj, mat4 inv_proj, highp sampler2D depth, float eps)
+// pushed back along the view ray by what push and eps say (visibility_push.glsl). -1 when c is not behind
+// it (off screen, background).
+#include "visibility_push.glsl"
+
+float rs_behind_visible(vec3 c, mat4 proj, mat4 inv_proj, highp sampler2D depth, highp sampler2D push, float eps)
 {
     vec4 clip = proj * vec4(c, 1.0);
     if (clip.w <= 0.0) return -1.0;
@@ -15,5 +18,5 @@ float rs_behind_visible(vec3 c, mat4 proj, mat4 inv_proj, highp sampler2D depth,
     float z = texelFetch(depth, px, 0).r;
     if (z >= 1.0) return -1.0;
     vec4 h = inv_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
-    return length(c) - (length(h.xyz / h.w) - eps);
+    return length(c) - (length(h.xyz / h.w) - rs_push_at(push, px, eps));
 }

@@ -13,6 +13,7 @@ layout(location = 2) in vec3 a_irradiance;  // E
 uniform mat4 u_view;
 uniform mat4 u_inv_proj;
 uniform highp sampler2D u_depth;  // visibility depth
+uniform highp sampler2D u_push;   // and its push (visibility_push.glsl)
 uniform float u_eps;
 uniform float u_radius_scale;   // LOD of this level: sqrt(N / n)
 uniform float u_sigma;          // the level's Gaussian sigma, view units (sqrt(variance_mm2) / mm_per_unit)
@@ -34,7 +35,7 @@ void main()
     float sigma = max(u_sigma, 0.5 * max(r, -c.z * u_px_size));
     // Back-facing splats deep behind the visible surface (the back of the head) reach no visible pixel.
     if (dot(mat3(u_view) * s.normal, -c) < 0.0
-        && rs_behind_visible(c, u_proj, u_inv_proj, u_depth, u_eps) > 3.0 * sigma) {
+        && rs_behind_visible(c, u_proj, u_inv_proj, u_depth, u_push, u_eps) > 3.0 * sigma) {
         rs_sprite_cull();
         return;
     }

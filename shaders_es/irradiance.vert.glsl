@@ -26,6 +26,7 @@ uniform vec3 u_fill_dir;
 uniform vec3 u_fill_color;      // zero when the fill light is off
 uniform vec3 u_ambient;
 uniform highp sampler2D u_depth;  // visibility depth
+uniform highp sampler2D u_push;   // and its push (visibility_push.glsl)
 uniform float u_eps;
 uniform float u_reach;          // the widest kernel's reach (3 sigma), view units
 
@@ -49,7 +50,7 @@ void main()
     rs_splat s = rs_decode_splat(a_splat);
     vec3 c = (u_view * vec4(s.pos, 1.0)).xyz;
     vec3 n = mat3(u_view) * s.normal;
-    float behind = dot(n, -c) < 0.0 ? rs_behind_visible(c, u_proj, u_inv_proj, u_depth, u_eps) : -1.0;
+    float behind = dot(n, -c) < 0.0 ? rs_behind_visible(c, u_proj, u_inv_proj, u_depth, u_push, u_eps) : -1.0;
     vec3 e = u_key_color * max(dot(n, u_key_dir), 0.0);
     // Splats no kernel carries to a visible pixel (the back of the head, the shoulders below the view)
     // skip the shadow-map lookup: their E is not read in this view. The pass that makes the E kept for

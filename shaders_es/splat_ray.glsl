@@ -33,10 +33,7 @@ bool rs_ray_disk(vec3 o, vec3 d, vec3 c, vec3 n, float r, float reach, out vec3 
     return l <= reach;
 }
 
-// How far the visibility pass pushes a disk's outer part back beyond u_eps, at most, in u_eps
-// (visibility.frag.glsl), and the radius (in radii) where that starts.
-const float RS_PUSH_MAX = 4.0;
-const float RS_PUSH_FROM = 0.5;
+#include "visibility_push.glsl"
 
 // Window depth (default depth range) of a view-space point.
 float rs_depth_of(vec3 q)
@@ -46,8 +43,8 @@ float rs_depth_of(vec3 q)
 }
 
 #ifdef RS_NEEDS_VISIBLE_POINT
-uniform highp sampler2D u_depth;  // visibility pass depth, pushed back by u_eps (1 + RS_PUSH_MAX push) along the view ray
-uniform highp sampler2D u_push;   // that push (R8), visibility.frag.glsl
+uniform highp sampler2D u_depth;  // visibility pass depth, pushed back along the view ray (visibility_push.glsl)
+uniform highp sampler2D u_push;   // that push beyond u_eps, R8
 uniform float u_eps;              // view units
 
 // The front surface point under pixel px of the depth texture (view space), undoing the visibility
@@ -62,7 +59,7 @@ bool rs_visible_point_at(ivec2 px, out vec3 p)
     vec2 ndc = (vec2(px) + 0.5) / vec2(textureSize(u_depth, 0)) * 2.0 - 1.0;
     vec4 h = u_inv_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
     p = h.xyz / h.w;
-    p -= normalize(p) * (u_eps * (1.0 + RS_PUSH_MAX * texelFetch(u_push, px, 0).r));
+    p -= normalize(p) * rs_push_at(u_push, px, u_eps);
     return true;
 }
 

@@ -17,7 +17,7 @@ flat in float v_r;
 flat in uint v_id;
 layout(location = 0) out uint o_id;
 #elif !defined(RS_SHADOW)
-layout(location = 0) out float o_push;  // the push beyond u_eps, in RS_PUSH_MAX u_eps (splat_ray.glsl undoes it)
+layout(location = 0) out float o_push;  // the push beyond u_eps, in RS_PUSH_MAX u_eps (visibility_push.glsl)
 #endif
 #if defined(RS_SHADOW) && defined(RS_QUADS)
 in vec2 v_disk;

@@ -293,6 +293,7 @@ static rs_result irradiance_pass(rs_renderer *r, const rs_frame *f, const rs_dif
     rs_render_shadow_uniforms(r, f, prog);
     rs_render_env_uniforms(r, f, prog);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+    rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
     // The depth texture is sampled: the framebuffer bound must not hold it, even with rasterisation off
     // (a feedback loop that WebGL refuses and GLES leaves undefined). The diffuse target has no depth.
     glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_diffuse);
