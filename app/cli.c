@@ -198,7 +198,8 @@ rs_result rs_cli_parse(int argc, char **argv, bool allow_output, rs_cli *out, rs
         // A second -o (or any option) silently winning hides a typo; say so instead.
         if (seen[o - opts]) return rs_fail(err, RS_ERR_ARG, "%s given twice", a);
         seen[o - opts] = true;
-        if (!strcmp(a, "-o") && !allow_output) return rs_fail(err, RS_ERR_ARG, "-o is only for 'rouge render'");
+        if ((!strcmp(a, "-o") || !strcmp(a, "--supersample")) && !allow_output)
+            return rs_fail(err, RS_ERR_ARG, "%s is only for 'rouge render'", a);
         const char *v = NULL;
         if (o->kind != OPT_FLAG) {
             if (i + 1 >= argc) return rs_fail(err, RS_ERR_ARG, "%s needs a value (%s)", a, o->arg);

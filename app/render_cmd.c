@@ -176,7 +176,8 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
         if (!r) r = rouge_face_set_view(face, &t, &e);
     }
     rs_image still = {0};
-    if (!r) r = cli->supersample > 1 ? render_supersampled(face, cli->supersample, &still, &e) : rouge_face_render(face, &e);
+    if (!r && cli->supersample > 1) r = render_supersampled(face, cli->supersample, &still, &e);
+    else if (!r) r = rouge_face_render(face, &e);
     // The look is saved only once the render it belongs to has succeeded, and before the PNG, so a look
     // that cannot be written leaves no picture claiming it was.
     if (!r && cli->save_look) r = rouge_face_save_look(face, cli->save_look, &e);

@@ -411,6 +411,7 @@ size_garbage|--size|--size 64x64x64
 two_faces|unexpected argument|tests/fixtures/rsf/tiny_v1.rsf
 EOF
 bad_input cli_view_with_output "-o given to the viewer" 2 "-o is only for" - "$rouge" view "$face" -o "$tmp/o.png"
+bad_input cli_view_with_supersample "--supersample given to the viewer" 2 "--supersample is only for" - "$rouge" view "$face" --supersample 2
 bad_input cli_save_look_alone "--save-look without --look or --strokes" 2 "--save-look" "$tmp/x.look" \
     render "$face" -o "$tmp/o.png" --save-look "$tmp/x.look"
 
