@@ -114,25 +114,17 @@ static rs_result check_inputs(const char *face, const char *look, rs_error *err)
     return r;
 }
 
-// Supersampling: the frame drawn n times wider and taller (the same camera: the framing does not depend on
-// the size), read back and averaged down in linear light into out. Edges the renderer leaves as one-pixel
-// steps (the lip line over the lower lip, the nose's base, an eyelid: inside the face only the silhouette is
-// anti-aliased) come out as a camera's pixels would show them.
-static rouge_result render_supersampled(rouge_face *face, int n, rs_image *out, rouge_error *e)
+rs_result rs_app_render_supersampled(rouge_face *face, int n, rs_image *out, rs_error *err)
 {
     rouge_view v = rouge_face_get_view(face);
-    v.width *= n, v.height *= n;
-    rouge_result r = rouge_face_set_view(face, &v, e);
-    if (!r) r = rouge_face_render(face, e);
+    v.width = (v.width ? v.width : 512) * n, v.height = (v.height ? v.height : 512) * n;
+    rouge_error e = {0};
     rs_image big = {0};
-    rs_error ie = {0};
-    if (!r && rs_image_create(v.width, v.height, 4, &big, &ie) != RS_OK) r = (rouge_result)ie.code;
-    if (!r) r = rouge_face_read_rgba(face, big.pixels, (size_t)v.width * v.height * 4, e);
-    if (!r && rs_image_downsample(&big, n, out, &ie) != RS_OK) r = (rouge_result)ie.code;
-    if (ie.code) {
-        e->code = r;
-        snprintf(e->msg, sizeof e->msg, "%s", ie.msg);
-    }
+    rs_result r = rs_app_error(rouge_face_set_view(face, &v, &e), &e, err);
+    if (!r) r = rs_app_error(rouge_face_render(face, &e), &e, err);
+    if (!r) r = rs_image_create(v.width, v.height, 4, &big, err);
+    if (!r) r = rs_app_error(rouge_face_read_rgba(face, big.pixels, (size_t)v.width * v.height * 4, &e), &e, err);
+    if (!r) r = rs_image_downsample(&big, n, out, err);
     rs_image_free(&big);
     return r;
 }
@@ -176,20 +168,16 @@ rs_result rs_app_render(const rs_cli *cli, rs_error *err)
         if (!r) r = rouge_face_set_view(face, &t, &e);
     }
     rs_image still = {0};
-    if (!r && cli->supersample > 1) r = render_supersampled(face, cli->supersample, &still, &e);
-    else if (!r) r = rouge_face_render(face, &e);
+    rs_result res = rs_app_error(r, &e, err);
+    if (!res && cli->supersample > 1) res = rs_app_render_supersampled(face, cli->supersample, &still, err);
+    else if (!res) res = rs_app_error(rouge_face_render(face, &e), &e, err);
     // The look is saved only once the render it belongs to has succeeded, and before the PNG, so a look
     // that cannot be written leaves no picture claiming it was.
-    if (!r && cli->save_look) r = rouge_face_save_look(face, cli->save_look, &e);
-    rs_error ie = {0};
-    if (!r && !still.pixels) {
-        r = rouge_face_write_png(face, cli->output, &e);
-    } else if (!r && rs_image_write_png(cli->output, &still, &ie) != RS_OK) {
-        r = e.code = (rouge_result)ie.code;
-        snprintf(e.msg, sizeof e.msg, "%s", ie.msg);
-    }
+    if (!res && cli->save_look) res = rs_app_error(rouge_face_save_look(face, cli->save_look, &e), &e, err);
+    if (!res && still.pixels) res = rs_image_write_png(cli->output, &still, err);
+    else if (!res) res = rs_app_error(rouge_face_write_png(face, cli->output, &e), &e, err);
     rs_image_free(&still);
     rouge_face_destroy(face);
     rs_gl_destroy(gl);
-    return rs_app_error(r, &e, err);
+    return res;
 }

@@ -201,10 +201,30 @@ void vw_looks_export(vw_viewer *v)
     L->export_pending = false;
     char png[1100], look[1100];
     export_paths(L->export_path, png, sizeof png, look, sizeof look);
+    // The current look at full quality, without the split or the UI: the face's view (its last frame's)
+    // drawn at twice the size and averaged down (rs_app_render_supersampled: the lip line and the nose's
+    // base without the one-pixel steps the screen shows), then the view set back and drawn again. A window
+    // past 16 megapixels supersampled (4K and up: a software GL keeps its targets in CPU memory) exports
+    // the frame on screen as it is.
+    rouge_view keep = rouge_face_get_view(v->face);
     rouge_error e = {0};
-    // The face's own last frame: the current look at full quality, without the split or the UI.
-    if (rouge_face_write_png(v->face, png, &e) != ROUGE_OK || rouge_face_save_look(v->face, look, &e) != ROUGE_OK) {
-        vw_toast(v, true, "%s", e.msg);
+    rs_error err = {0};
+    rs_image img = {0};
+    rs_result r;
+    if ((double)keep.width * keep.height * 4.0 <= 16.8e6) {
+        r = rs_app_render_supersampled(v->face, 2, &img, &err);
+        // The face's frame is what strokes pick in and what the screen shows: drawn again at once.
+        rs_result back = rs_app_error(rouge_face_set_view(v->face, &keep, &e), &e, r ? NULL : &err);
+        if (!back) back = rs_app_error(rouge_face_render(v->face, &e), &e, r ? NULL : &err);
+        if (!r) r = back;
+        if (!r) r = rs_image_write_png(png, &img, &err);
+        rs_image_free(&img);
+    } else {
+        r = rs_app_error(rouge_face_write_png(v->face, png, &e), &e, &err);
+    }
+    if (!r) r = rs_app_error(rouge_face_save_look(v->face, look, &e), &e, &err);
+    if (r) {
+        vw_toast(v, true, "%s", err.msg);
         return;
     }
     const char *base = strrchr(look, '/');

@@ -458,7 +458,7 @@ if selected viewer_and_rouge_render_show_the_same_look; then
     if [ ! -f "$out/same/rouge-0002.png" ] || [ ! -s "$out/same/look.strokes" ]; then
         echo "FAIL - $name: no screenshot or recording ($(tail -c 200 "$out/same.log"))"
     elif ! timeout 180 "$rouge" render "$face" --strokes "$out/same/look.strokes" --size "$size" --max-splats "$face_splats" \
-        --pipeline mobile -o "$out/same/render.png" >"$out/same_render.log" 2>&1; then
+        --pipeline mobile --supersample 2 -o "$out/same/render.png" >"$out/same_render.log" 2>&1; then
         echo "FAIL - $name: rouge render failed: $(tail -c 300 "$out/same_render.log")"
     else
         # Same look: within 8 levels nearly everywhere; and the stroke is really there (the viewer's shot
@@ -607,7 +607,7 @@ if selected viewer_product_editor_paints_and_saves_a_custom_product; then
         ! echo "$line" | grep -Eq 'coverage=0\.(7|69999)'; then
         echo "FAIL - $name: the look does not carry the custom product: $line"
     elif ! timeout 180 "$rouge" render "$face" --look "$look" --size "$size" --max-splats "$face_splats" --pipeline mobile \
-        --zoom 0.85 -o "$out/editor/render.png" >"$out/editor_render.log" 2>&1; then
+        --zoom 0.85 --supersample 2 -o "$out/editor/render.png" >"$out/editor_render.log" 2>&1; then
         echo "FAIL - $name: rouge render --look failed: $(tail -c 300 "$out/editor_render.log")"
     else
         same=$("$imgdiff" "$out/editor/rouge-0001.png" "$out/editor/render.png" --threshold 8 2>&1 | awk '/^frac_over/ {print $2}')
