@@ -126,6 +126,12 @@ rs_result rs_app_render_supersampled(rouge_face *face, int n, rs_image *out, rs_
     if (!r) r = rs_app_error(rouge_face_read_rgba(face, big.pixels, (size_t)v.width * v.height * 4, &e), &e, err);
     if (!r) r = rs_image_downsample(&big, n, out, err);
     rs_image_free(&big);
+    if (r && err) {
+        // The sizes in the message are the larger frame's: say where they come from.
+        char msg[sizeof err->msg];
+        snprintf(msg, sizeof msg, "%s", err->msg);
+        rs_fail(err, r, "supersampled %dx: %s", n, msg);
+    }
     return r;
 }
 

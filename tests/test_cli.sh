@@ -95,6 +95,9 @@ expect cli_supersample_out_of_range 2 "--supersample: 5 is out of range 1..4" "$
 expect cli_supersample_over_max_size 2 "--supersample 3: 4000x4000 would be drawn at 12000x12000" \
     "$rouge" render "$face" -o "$tmp/s.png" --size 4000x4000 --supersample 3 --mode albedo
 no_file cli_supersample_over_max_size_leaves_no_output "$tmp/s.png"
+expect cli_supersample_bounded_by_target_memory 1 "supersampled 4x: render: 8192x8192 needs about" \
+    "$rouge" render "$face" -o "$tmp/s.png" --size 2048x2048 --supersample 4 --mode albedo
+no_file cli_supersample_memory_leaves_no_output "$tmp/s.png"
 # A supersampled still has the size asked for and the plain render's picture, its edges averaged (not equal).
 if "$rouge" render "$face" -o "$tmp/s1.png" --size 48x40 --max-splats 2000 --mode albedo >/dev/null 2>"$tmp/err" &&
     "$rouge" render "$face" -o "$tmp/s2.png" --size 48x40 --max-splats 2000 --mode albedo --supersample 2 >/dev/null 2>>"$tmp/err" &&
