@@ -1,7 +1,8 @@
 #version 300 es
 // visibility.frag.glsl — per-pixel ray-disk intersection; writes the hit's depth, pushed back along the
 // view ray in the visibility pass by u_eps (more towards the rim) so that the attribute pass blends every
-// splat of the front surface layer (Botsch et al. 2005). RS_PICK also writes the splat index + 1 (0 = background).
+// splat of the front surface layer (Botsch et al. 2005). RS_PICK also writes the splat index + 1
+// (0 = background).
 precision highp float;
 precision highp int;
 #include "splat_ray.glsl"
@@ -17,7 +18,7 @@ flat in float v_r;
 flat in uint v_id;
 layout(location = 0) out uint o_id;
 #elif !defined(RS_SHADOW)
-layout(location = 0) out float o_push;  // the push beyond u_eps, in RS_PUSH_MAX u_eps (visibility_push.glsl)
+layout(location = 0) out float o_push;  // the extra push's share (visibility_push.glsl)
 #endif
 #if defined(RS_SHADOW) && defined(RS_QUADS)
 in vec2 v_disk;
@@ -42,10 +43,10 @@ void main()
     // silhouette) nothing changes. Inside one surface some disk's centre is nearer than RS_PUSH_FROM
     // radii at most pixels (the disks overlap that much: on the bundled face the push is 0 at 83 % of
     // them, and mostly small in the gaps between centres).
-    float push = smoothstep(RS_PUSH_FROM, 1.0, l);
-    gl_FragDepth = rs_depth_of(q + d * (u_eps * (1.0 + RS_PUSH_MAX * push)));
+    float share = smoothstep(RS_PUSH_FROM, 1.0, l);
+    gl_FragDepth = rs_depth_of(q + d * rs_push(share, u_eps));
 #if !defined(RS_PICK) && !defined(RS_SHADOW)
-    o_push = push;
+    o_push = share;
 #endif
 #endif
 #ifdef RS_PICK

@@ -1,7 +1,8 @@
 #version 300 es
 // visibility.vert.glsl — stage 2, visibility splatting (Botsch et al. 2005): every splat as a disk in a
-// depth pass (and its push, visibility.frag.glsl). The same program draws stage 1's shadow map (from the light, RS_SHADOW) and the ID
-// buffer for picking (RS_PICK). RS_QUADS: instanced quads instead of point sprites.
+// depth pass (and its push, visibility.frag.glsl). The same program draws stage 1's shadow map (from the
+// light, RS_SHADOW) and the ID buffer for picking (RS_PICK). RS_QUADS: instanced quads instead of point
+// sprites.
 precision highp float;
 precision highp int;
 #include "splat_decode.glsl"

@@ -7,9 +7,15 @@
 const float RS_PUSH_MAX = 4.0;
 const float RS_PUSH_FROM = 0.5;
 
-// The push at depth-texture pixel px (view units), from the R8 target push and the frame's eps.
+// The push (view units) for share 0..1 of the extra push (what the R8 target keeps) and the frame's eps.
+float rs_push(float share, float eps)
+{
+    return eps * (1.0 + RS_PUSH_MAX * share);
+}
+
+// The push at depth-texture pixel px, from the R8 target push.
 float rs_push_at(highp sampler2D push, ivec2 px, float eps)
 {
-    return eps * (1.0 + RS_PUSH_MAX * texelFetch(push, px, 0).r);
+    return rs_push(texelFetch(push, px, 0).r, eps);
 }
 #endif
