@@ -83,9 +83,12 @@ static const measured was[] = {
     // 0.99 -> 0.87 / 0.96; bands within 0.002. Daylight front's band under the jaw stays 0.991: at 768 px
     // the reference's skin there is lit 3x more by its specular (its glossy passes: reflecting the neck)
     // while rouge's reflection march and bent cone both find that direction open.
-    {"studio", "front", 1.30, {1.012, 1.043, 0.967, 1.015, 1.009}, 1.135, 0.21},
+    // The contours inside the face anti-aliased (edges.frag.glsl): the first pixel of a step's near side now
+    // shows some of the surface behind it, which under the jaw is darker than the path tracer's neck: band
+    // daylight front 0.998 -> 0.997 (inner steps 0.991 -> 0.989), the others within 0.002; dE within 0.01.
+    {"studio", "front", 1.31, {1.012, 1.042, 0.972, 1.015, 1.007}, 1.133, 0.21},
     {"studio", "threequarter", 1.62, {1.005, 1.057, 0.982, 1.023, 0.998}, 1.004, 0.08},
-    {"daylight", "front", 1.13, {0.989, 1.058, 1.032, 1.018, 1.032}, 0.998, 0.00},
+    {"daylight", "front", 1.13, {0.989, 1.057, 1.030, 1.017, 1.030}, 0.997, 0.00},
     {"daylight", "threequarter", 1.15, {0.966, 1.057, 0.992, 1.006, 1.018}, 1.002, 0.00},
     {"office", "front", 1.45, {1.030, 1.050, 1.051, 1.009, 0.989}, 1.055, 0.00},
     {"office", "threequarter", 1.37, {0.971, 1.053, 1.022, 0.995, 0.960}, 1.060, 0.00},

@@ -149,16 +149,17 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
 
 static void release_targets(rs_renderer *r)
 {
-    GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_diffuse, r->fbo_out};
+    GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_diffuse, r->fbo_pre, r->fbo_edges, r->fbo_out};
     glDeleteFramebuffers((GLsizei)RS_COUNT_OF(fbos), fbos);
-    GLuint texs[] = {r->depth_tex, r->push_tex, r->diffuse_tex, r->out_tex};
+    GLuint texs[] = {r->depth_tex, r->push_tex, r->diffuse_tex, r->pre_tex, r->out_steps_tex[0], r->out_steps_tex[1],
+                     r->mask_tex};
     glDeleteTextures((GLsizei)RS_COUNT_OF(texs), texs);
     glDeleteTextures(RS_ATTR_TARGETS, r->attr_tex);
     rs_render_level_release(r);
-    r->fbo_vis = r->fbo_attr = r->fbo_diffuse = r->fbo_out = 0;
+    r->fbo_vis = r->fbo_attr = r->fbo_diffuse = r->fbo_pre = r->fbo_edges = r->fbo_out = 0;
     r->depth_tex = r->push_tex = 0;
     memset(r->attr_tex, 0, sizeof r->attr_tex);
-    r->diffuse_tex = r->out_tex = 0;
+    r->diffuse_tex = r->pre_tex = r->out_steps_tex[0] = r->out_steps_tex[1] = r->mask_tex = 0;
     r->tw = r->th = 0;
     r->have_frame = false;
     r->inc_valid = false;
@@ -200,13 +201,14 @@ static GLuint fbo_with(const GLuint *colour, int ncolour, GLuint depth)
     return fbo;
 }
 
-// Render targets of a w x h frame: depth and its push, four attribute targets, diffuse, output, the
+// Render targets of a w x h frame: depth and its push, four attribute targets, diffuse, the composite's
+// picture, the output (the picture's depth steps anti-aliased), the steps and their mask, the
 // reduced-resolution diffusion levels (at most 4/3 of one accumulation target) and the ID buffer (R32UI +
 // depth). llvmpipe keeps all of it in CPU memory, so this is what a frame size costs the machine.
 static double target_estimate(int w, int h, bool float_rt)
 {
     double px = (double)w * h, acc = float_rt ? 8 : 4;
-    return px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + acc * 4.0 / 3.0 + 8);
+    return px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + 4 + 2 + 2 + acc * 4.0 / 3.0 + 8);
 }
 
 static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
@@ -225,7 +227,10 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
     // The bent normal's target is RGBA8 whatever the others are (attribute.frag.glsl).
     for (int i = 0; i < RS_ATTR_TARGETS; i++) r->attr_tex[i] = rs_render_texture(i < 3 ? acc : GL_RGBA8, w, h);
     r->diffuse_tex = rs_render_texture(acc, w, h);
-    r->out_tex = rs_render_texture(GL_RGBA8, w, h);
+    r->pre_tex = rs_render_texture(GL_RGBA8, w, h);
+    r->out_steps_tex[0] = rs_render_texture(GL_RGBA8, w, h);
+    r->out_steps_tex[1] = rs_render_texture(GL_RG8, w, h);
+    r->mask_tex = rs_render_texture(GL_DEPTH_COMPONENT16, w, h);
     const char *acc_name = r->float_rt ? "RGBA16F" : "RGBA8";
     struct {
         GLuint *fbo;
@@ -238,7 +243,9 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
         {&r->fbo_vis, &r->push_tex, 1, r->depth_tex, "visibility target", "DEPTH_COMPONENT32F + R8"},
         {&r->fbo_attr, r->attr_tex, RS_ATTR_TARGETS, r->depth_tex, "attribute targets", acc_name},
         {&r->fbo_diffuse, &r->diffuse_tex, 1, 0, "diffuse target", acc_name},
-        {&r->fbo_out, &r->out_tex, 1, 0, "output target", "RGBA8"},
+        {&r->fbo_pre, &r->pre_tex, 1, 0, "composite target", "RGBA8"},
+        {&r->fbo_edges, r->out_steps_tex, 2, r->mask_tex, "depth steps targets", "RGBA8 + RG8 + DEPTH_COMPONENT16"},
+        {&r->fbo_out, r->out_steps_tex, 1, r->mask_tex, "output target", "RGBA8 + DEPTH_COMPONENT16"},
     };
     for (size_t i = 0; i < RS_COUNT_OF(t); i++) {
         *t[i].fbo = fbo_with(t[i].colour, t[i].n, t[i].depth);
@@ -260,7 +267,8 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
 static size_t target_bytes(const rs_renderer *r)
 {
     size_t px = (size_t)r->tw * (size_t)r->th, acc = r->float_rt ? 8 : 4;
-    size_t bytes = px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4);  // depth, push, attributes, D, out
+    // depth, push, attributes, D, the composite's picture, the output, its steps and their mask
+    size_t bytes = px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + 4 + 2 + 2);
     for (int i = 0; i < RS_LEVEL_DIVS; i++)
         if (r->level_tex[i]) bytes += px * acc >> (2 * i);
     return bytes;
@@ -308,7 +316,8 @@ static bool same_view(const rs_view *a, const rs_view *b)
            a->max_splats == b->max_splats && a->kernel_count == b->kernel_count && a->lod_density == b->lod_density &&
            a->prim == b->prim && a->ambient == b->ambient && a->lighting == b->lighting &&
            a->env_rotate_deg == b->env_rotate_deg && a->env_intensity == b->env_intensity && a->tonemap == b->tonemap &&
-           a->linear_output == b->linear_output && a->use_matrices == b->use_matrices &&
+           a->linear_output == b->linear_output && a->sharp_contours == b->sharp_contours &&
+           a->use_matrices == b->use_matrices &&
            (!a->use_matrices || (!memcmp(a->view_matrix, b->view_matrix, sizeof a->view_matrix) &&
                                  !memcmp(a->proj_matrix, b->proj_matrix, sizeof a->proj_matrix)));
 }
@@ -362,6 +371,9 @@ static rs_result incremental_frame(rs_renderer *r, rs_frame *f, rs_error *err)
         rs_render_diffusion_plan(r, f, levels, f->delta_weight);  // the per-pixel weights; D stays
     }
     if (res == RS_OK) res = rs_render_composite(r, f, err);
+    // An output pixel mixes its 4-neighbours' colours.
+    glScissor(x0 - 1, y0 - 1, x1 - x0 + 2, y1 - y0 + 2);
+    if (res == RS_OK) res = rs_render_edges(r, f, err);
     glDisable(GL_SCISSOR_TEST);
     return res;
 }
@@ -433,6 +445,7 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     stage_mark(r, RS_STAGE_DIFFUSION, &t);
     if (res == RS_OK) res = stage_hook(r, RS_STAGE_COMPOSITE, err);
     if (res == RS_OK) res = rs_render_composite(r, &f, err);
+    if (res == RS_OK) res = rs_render_edges(r, &f, err);
     stage_mark(r, RS_STAGE_COMPOSITE, &t);
     if (res == RS_OK) res = stage_hook(r, RS_STAGE_COUNT, err);
 
@@ -475,7 +488,7 @@ GLuint rs_render_output_texture(const rs_renderer *r, int *width, int *height)
 {
     if (width) *width = r->have_frame ? r->tw : 0;
     if (height) *height = r->have_frame ? r->th : 0;
-    return r->have_frame ? r->out_tex : 0;
+    return r->have_frame ? r->out_steps_tex[0] : 0;
 }
 
 rs_result rs_render_read(rs_renderer *r, rs_image *out, rs_error *err)

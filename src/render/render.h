@@ -26,6 +26,9 @@
 
 // Largest render-target memory a frame may ask for (depth, attributes, diffusion, output, ID buffer).
 #define RS_RENDER_MAX_TARGET_BYTES (1536.0 * 1024 * 1024)
+// Texture units a frame binds, 0 .. RS_RENDER_TEXTURE_UNITS - 1 (2D, 3D and 2D-array targets), and leaves
+// empty: what an embedding that keeps its host's bindings saves.
+#define RS_RENDER_TEXTURE_UNITS 17
 
 typedef enum rs_render_mode {
     RS_MODE_FULL = 0,   // subsurface + specular (paper Fig. 7 right)
@@ -106,6 +109,7 @@ typedef struct rs_view {
     float env_intensity;        // multiplies the environment (after its normalisation); 0 means 1
     rs_tonemap tonemap;
     bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)
+    bool sharp_contours;        // tests: no anti-aliasing of the depth steps inside the face (the composite's own)
     // A host's camera instead of the orbit one (yaw, pitch, zoom, fov, pan ignored): model -> eye (rigid)
     // and a perspective eye -> clip, column-major (rouge.h rouge_view.use_matrices; checked by the caller).
     bool use_matrices;

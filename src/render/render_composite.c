@@ -16,7 +16,7 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     if (res != RS_OK) return res;
     const rs_camera *cam = &f->cam;
     const rs_view *v = &f->view;
-    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_out);
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_pre);
     glViewport(0, 0, cam->width, cam->height);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
@@ -71,5 +71,53 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
     for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_FINE_INDEX; i++) rs_render_bind_texture(i, 0);
     rs_render_fine_unbind();
+    return RS_OK;
+}
+
+rs_result rs_render_edges(rs_renderer *r, const rs_frame *f, rs_error *err)
+{
+    GLuint find, blend;
+    rs_result res = rs_render_program(r, RS_PROG_EDGES_FIND, false, &find, err);
+    if (res == RS_OK) res = rs_render_program(r, RS_PROG_EDGES, false, &blend, err);
+    if (res != RS_OK) return res;
+    const rs_camera *cam = &f->cam;
+    glViewport(0, 0, cam->width, cam->height);
+    glDisable(GL_BLEND);
+    glBindVertexArray(r->vao_empty);
+    // The steps, the picture copied to the output, and the mask: depth 0 on a step, 1 elsewhere.
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_edges);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_ALWAYS);
+    glDepthMask(GL_TRUE);
+    glUseProgram(find);
+    glUniformMatrix4fv(rs_uloc(find, "u_inv_proj"), 1, GL_FALSE, (const float *)cam->inv_proj);
+    glUniform2f(rs_uloc(find, "u_viewport"), (float)cam->width, (float)cam->height);
+    glUniform1f(rs_uloc(find, "u_eps"), f->eps);
+    // Half a millimetre: the lip line's step, the smallest contour that draws a staircase.
+    glUniform1f(rs_uloc(find, "u_step_min"), 0.5f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
+    // The views of data (normals, regions, LOD levels) show each pixel's own, unmixed.
+    rs_render_mode m = f->view.mode;
+    bool data = m == RS_MODE_NORMALS || m == RS_MODE_REGIONS || m == RS_MODE_LOD;
+    glUniform1i(rs_uloc(find, "u_enabled"), data || f->view.sharp_contours ? 0 : 1);
+    rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+    rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
+    rs_render_bind_texture(RS_UNIT_COLOR, r->pre_tex);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    // The mixing, only where the mask is nearer than the triangle (depth 0.5): early depth tests skip the
+    // rest of the picture, which was copied.
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_out);
+    glDepthFunc(GL_GREATER);
+    glDepthMask(GL_FALSE);
+    glUseProgram(blend);
+    glUniform1f(rs_uloc(blend, "u_linear_output"), f->view.linear_output ? 1.0f : 0.0f);
+    rs_render_bind_texture(RS_UNIT_EDGES, r->out_steps_tex[1]);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glDisable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);  // GL's default, as the caller may expect it
+    rs_render_bind_texture(RS_UNIT_DEPTH, 0);
+    rs_render_bind_texture(RS_UNIT_PUSH, 0);
+    rs_render_bind_texture(RS_UNIT_COLOR, 0);
+    rs_render_bind_texture(RS_UNIT_EDGES, 0);
     return RS_OK;
 }

@@ -43,6 +43,8 @@ static const char *const prog_files[RS_PROG_COUNT][2] = {
     [RS_PROG_RESOLVE] = {"fullscreen.vert.glsl", "diffusion_resolve.frag.glsl"},
     [RS_PROG_COMPOSITE] = {"fullscreen.vert.glsl", "composite.frag.glsl"},
     [RS_PROG_IRRADIANCE] = {"irradiance.vert.glsl", "irradiance.frag.glsl"},
+    [RS_PROG_EDGES_FIND] = {"fullscreen.vert.glsl", "edges_find.frag.glsl"},
+    [RS_PROG_EDGES] = {"fullscreen.vert.glsl", "edges.frag.glsl"},
 };
 
 static const char *const prog_defines[RS_PROG_COUNT] = {
@@ -97,6 +99,8 @@ rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *ou
     glUniform1i(rs_uloc(p, "u_level"), RS_UNIT_LEVEL);
     glUniform1i(rs_uloc(p, "u_env_map"), RS_UNIT_ENV);
     glUniform1i(rs_uloc(p, "u_spec_lut"), RS_UNIT_SPEC_LUT);
+    glUniform1i(rs_uloc(p, "u_color"), RS_UNIT_COLOR);
+    glUniform1i(rs_uloc(p, "u_edges"), RS_UNIT_EDGES);
     glUniform1f(rs_uloc(p, "u_has_ao"), (h->flags & RS_SPLAT_FLAG_AO) ? 1.0f : 0.0f);
     glUniform1f(rs_uloc(p, "u_has_bent"), (h->flags & RS_SPLAT_FLAG_BENT) ? 1.0f : 0.0f);
     r->prog[kind][q] = p;

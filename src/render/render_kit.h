@@ -32,6 +32,8 @@ typedef enum rs_prog {
     RS_PROG_RESOLVE = RS_PROG_SPLAT_COUNT,
     RS_PROG_COMPOSITE,
     RS_PROG_IRRADIANCE,     // transform feedback: per-splat irradiance for stage 4
+    RS_PROG_EDGES_FIND,     // stage 5's end: the depth steps inside the face (and the picture copied),
+    RS_PROG_EDGES,          // then the steps anti-aliased
     RS_PROG_COUNT
 } rs_prog;
 
@@ -52,7 +54,11 @@ enum {
     RS_UNIT_FINE_INDEX,  // the fine layer's grid: cells (start, count) then stamp lists (u_fine_index, R32UI)
     RS_UNIT_FINE_FIELD,  // the region masks' fields stacked along z (u_fine_field, R8 3D, linear)
     RS_UNIT_LAMP_SHADOW, // the environment's other lamps' shadow maps, one atlas (u_lamp_shadow_map)
+    RS_UNIT_COLOR,       // the composite's picture before its contours are anti-aliased (u_color)
+    RS_UNIT_EDGES,       // the depth steps in it (u_edges, RG8)
+    RS_UNIT_COUNT
 };
+_Static_assert(RS_UNIT_COUNT <= RS_RENDER_TEXTURE_UNITS, "render.h's RS_RENDER_TEXTURE_UNITS");
 
 // The fine layer as uploaded (render_fine.c): per-pixel stamps over a model-space grid.
 typedef struct rs_render_fine {
@@ -223,8 +229,11 @@ struct rs_renderer {
 
     // Frame targets (width x height).
     int tw, th;
-    GLuint depth_tex, push_tex, attr_tex[RS_ATTR_TARGETS], diffuse_tex, out_tex;
-    GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_out;
+    GLuint depth_tex, push_tex, attr_tex[RS_ATTR_TARGETS], diffuse_tex;
+    GLuint pre_tex;             // the composite's picture, before its contours are anti-aliased
+    GLuint out_steps_tex[2];    // the output, and the depth steps in it (RG8; edges_find.frag.glsl)
+    GLuint mask_tex;            // depth 0 where a pixel has a step: the edges pass shades only those
+    GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_pre, fbo_edges, fbo_out;
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;
     // What the splats' light reads besides the frame's lights: bumped by every shadow map drawn and every
