@@ -47,7 +47,6 @@ _Static_assert((int)ROUGE_ERR_CANCELLED == (int)RS_ERR_ARG + 1, "ROUGE_ERR_CANCE
 #define ZOOM_MAX 12.0f
 #define PIXEL_RATIO_MIN 0.1f
 #define PIXEL_RATIO_MAX 16.0f
-#define MAX_TEXTURE_UNITS 8  // the renderer uses units 0..RS_UNIT_LEVEL (render_kit.h)
 
 // A stroke recording is rewritten whole after each stroke (temp file, fsync, rename: the file on disk is
 // always a complete recording). The writing happens on this thread, so ending a stroke costs only turning
@@ -362,13 +361,20 @@ static rs_result check_context(const rouge_face *f, rs_error *e)
     return RS_OK;
 }
 
+// The texture targets the renderer binds (the fine layer's fields are 3D, the lamps' shadow maps an array).
+static const struct {
+    GLenum target, binding;
+} texture_targets[3] = {{GL_TEXTURE_2D, GL_TEXTURE_BINDING_2D},
+                        {GL_TEXTURE_3D, GL_TEXTURE_BINDING_3D},
+                        {GL_TEXTURE_2D_ARRAY, GL_TEXTURE_BINDING_2D_ARRAY}};
+
 // Everything the renderer (or a blit) may change, saved on entry and put back on exit; on entry the
 // state the renderer assumes but never sets itself (no culling, scissor, stencil, polygon offset,
 // all colour channels written, default pixel store) is established.
 typedef struct gl_saved {
     GLint draw_fbo, read_fbo, viewport[4], scissor_box[4];
     GLint program, vao, array_buffer, tf_buffer, pack_buffer, unpack_buffer;
-    GLint active_texture, tex2d[MAX_TEXTURE_UNITS];
+    GLint active_texture, tex[RS_RENDER_TEXTURE_UNITS][3];  // per unit: 2D, 3D, 2D array
     GLint blend_src_rgb, blend_dst_rgb, blend_src_a, blend_dst_a, blend_eq_rgb, blend_eq_a;
     GLint depth_func, pixel_store[PIXEL_STORE_COUNT];
     GLboolean depth_mask, color_mask[4];
@@ -416,9 +422,9 @@ static void gl_capture(gl_saved *s)
     glGetIntegerv(GL_PIXEL_PACK_BUFFER_BINDING, &s->pack_buffer);
     glGetIntegerv(GL_PIXEL_UNPACK_BUFFER_BINDING, &s->unpack_buffer);
     glGetIntegerv(GL_ACTIVE_TEXTURE, &s->active_texture);
-    for (int i = 0; i < MAX_TEXTURE_UNITS; i++) {
+    for (int i = 0; i < RS_RENDER_TEXTURE_UNITS; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        glGetIntegerv(GL_TEXTURE_BINDING_2D, &s->tex2d[i]);
+        for (int t = 0; t < 3; t++) glGetIntegerv(texture_targets[t].binding, &s->tex[i][t]);
     }
     glGetIntegerv(GL_BLEND_SRC_RGB, &s->blend_src_rgb);
     glGetIntegerv(GL_BLEND_DST_RGB, &s->blend_dst_rgb);
@@ -471,9 +477,9 @@ static void gl_restore(const gl_saved *s)
     glBindBuffer(GL_TRANSFORM_FEEDBACK_BUFFER, (GLuint)s->tf_buffer);
     glBindBuffer(GL_PIXEL_PACK_BUFFER, (GLuint)s->pack_buffer);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, (GLuint)s->unpack_buffer);
-    for (int i = 0; i < MAX_TEXTURE_UNITS; i++) {
+    for (int i = 0; i < RS_RENDER_TEXTURE_UNITS; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
-        glBindTexture(GL_TEXTURE_2D, (GLuint)s->tex2d[i]);
+        for (int t = 0; t < 3; t++) glBindTexture(texture_targets[t].target, (GLuint)s->tex[i][t]);
     }
     glActiveTexture((GLenum)s->active_texture);
     glBlendFuncSeparate((GLenum)s->blend_src_rgb, (GLenum)s->blend_dst_rgb, (GLenum)s->blend_src_a,

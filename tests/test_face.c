@@ -104,9 +104,22 @@ static void test_draw_into_host_framebuffer_restores_state(void)
     glBindVertexArray(vao);
     glGenBuffers(1, &buf);
     glBindBuffer(GL_ARRAY_BUFFER, buf);
+    // A texture of each target the renderer binds on every unit GLES 3 guarantees (the renderer binds up
+    // to 17 units; a host's bindings on units 8 and up, and its 3D and array textures, were lost once).
+    enum { UNITS = 32 };
+    GLuint host_tex[UNITS][3];
+    const GLenum targets[3] = {GL_TEXTURE_2D, GL_TEXTURE_3D, GL_TEXTURE_2D_ARRAY};
+    const GLenum bindings[3] = {GL_TEXTURE_BINDING_2D, GL_TEXTURE_BINDING_3D, GL_TEXTURE_BINDING_2D_ARRAY};
+    glGenTextures(UNITS * 3, &host_tex[0][0]);
+    for (int u = 0; u < UNITS; u++) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)u);
+        for (int t = 0; t < 3; t++) glBindTexture(targets[t], host_tex[u][t]);
+    }
+    glDeleteTextures(1, &host_tex[3][0]);
     glGenTextures(1, &tex3);
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, tex3);
+    host_tex[3][0] = tex3;
     glViewport(20, 10, SIZE, SIZE);
     glEnable(GL_SCISSOR_TEST);
     glScissor(0, 0, 30, 30);
@@ -146,6 +159,16 @@ static void test_draw_into_host_framebuffer_restores_state(void)
     RS_CHECK(i == GL_TEXTURE3, "active texture");
     glGetIntegerv(GL_TEXTURE_BINDING_2D, &i);
     RS_CHECK(i == (GLint)tex3, "texture on unit 3");
+    int lost = 0;
+    for (int u = 0; u < UNITS; u++) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)u);
+        for (int t = 0; t < 3; t++) {
+            glGetIntegerv(bindings[t], &i);
+            lost += i != (GLint)host_tex[u][t];
+        }
+    }
+    glActiveTexture(GL_TEXTURE3);
+    RS_CHECK(lost == 0, "%d of the host's %d texture bindings lost", lost, UNITS * 3);
     glGetIntegerv(GL_PACK_ALIGNMENT, &i);
     RS_CHECK(i == 8, "pack alignment");
     RS_CHECK(glGetError() == GL_NO_ERROR, "GL error after draw");
@@ -179,8 +202,8 @@ static void test_draw_into_host_framebuffer_restores_state(void)
     glDeleteVertexArrays(1, &vao);
     glDeleteBuffers(1, &buf);
     glDeleteFramebuffers(1, &fbo);
-    GLuint texs[2] = {tex, tex3};
-    glDeleteTextures(2, texs);
+    glDeleteTextures(1, &tex);
+    glDeleteTextures(UNITS * 3, &host_tex[0][0]);  // tex3 among them
 }
 
 static rouge_error stroke_err;  // why the last stroke() failed
