@@ -18,6 +18,8 @@ uniform int u_enabled;            // 0: no steps (views of data, tests of the co
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec2 o_step;
 
+const float STEP_OVER_SLOPE = 3.0;  // a contour's step against the surfaces' own slopes beside it
+
 // View depth of the surface at pixel px as the visibility pass left it (pushed back by u_eps to
 // RS_PUSH_MAX + 1 u_eps), along z: neighbouring rays are parallel to far below the steps looked for; -1 for
 // the background and outside the target.
@@ -45,7 +47,7 @@ float step_to(ivec2 px, ivec2 n, float b)
     float a = depth_at(px - n), d = depth_at(px + 2 * n), j = abs(c - b), slope = 1e30;
     if (a >= 0.0) slope = min(slope, abs(b - a));
     if (d >= 0.0) slope = min(slope, abs(d - c));
-    if (slope < 1e30 && j <= 3.0 * slope) return 0.0;
+    if (slope < 1e30 && j <= STEP_OVER_SLOPE * slope) return 0.0;
     return c > b ? 0.5 : 1.0;
 }
 
