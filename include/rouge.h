@@ -10,10 +10,11 @@
 //     ratio of your window units (pointer events stay in your window's coordinates);
 //   - render it into your current GLES 3.0 context: into the framebuffer you have bound (rouge_face_draw),
 //     or into an RGBA8 texture it owns (rouge_face_render + rouge_face_texture); every GL state it
-//     touches (framebuffers, viewport, program, VAO, buffers, textures, blend/depth/scissor/stencil/cull,
-//     masks, the whole pack and unpack pixel-store state) is restored before it returns; your scissor,
-//     pixel-store settings and an sRGB framebuffer (it writes so the picture is encoded once) do not
-//     change what it draws or reads;
+//     touches (framebuffers, viewport, program, VAO, buffers, textures and samplers on every unit it
+//     uses, blend/depth/scissor/stencil/cull, depth range, clear values, masks, the transform feedback
+//     object, the whole pack and unpack pixel-store state) is restored before it returns; your scissor,
+//     sampler objects, depth range, pixel-store settings and an sRGB framebuffer (it writes so the
+//     picture is encoded once) do not change what it draws or reads;
 //   - take pointer / touch events (ids, pressure, time) and paint: smoothing, stamp spacing, picking
 //     through an ID buffer, one- and two-finger navigation; brush, eraser, smudge and blend tools,
 //     mirror, undo / redo / clear;

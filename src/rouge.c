@@ -370,16 +370,19 @@ static const struct {
 
 // Everything the renderer (or a blit) may change, saved on entry and put back on exit; on entry the
 // state the renderer assumes but never sets itself (no culling, scissor, stencil, polygon offset,
-// all colour channels written, default pixel store) is established.
+// all colour channels written, default pixel store, depth range 0..1, no sampler objects, the default
+// transform feedback object) is established.
 typedef struct gl_saved {
     GLint draw_fbo, read_fbo, viewport[4], scissor_box[4];
     GLint program, vao, array_buffer, tf_buffer, pack_buffer, unpack_buffer;
     GLint active_texture, tex[RS_RENDER_TEXTURE_UNITS][3];  // per unit: 2D, 3D, 2D array
+    GLint sampler[RS_RENDER_TEXTURE_UNITS];  // a host's sampler objects would override rouge's filtering
+    GLint tf_object;
     GLint blend_src_rgb, blend_dst_rgb, blend_src_a, blend_dst_a, blend_eq_rgb, blend_eq_a;
     GLint depth_func, pixel_store[PIXEL_STORE_COUNT];
     GLboolean depth_mask, color_mask[4];
     GLboolean blend, depth_test, scissor_test, stencil_test, cull_face, polygon_offset, discard, alpha_cov;
-    GLfloat depth_clear;
+    GLfloat depth_clear, depth_range[2], clear_color[4];
 } gl_saved;
 
 // Entry to every call that uses GL: the face's context must be current; errors the host left pending
@@ -425,7 +428,11 @@ static void gl_capture(gl_saved *s)
     for (int i = 0; i < RS_RENDER_TEXTURE_UNITS; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         for (int t = 0; t < 3; t++) glGetIntegerv(texture_targets[t].binding, &s->tex[i][t]);
+        glGetIntegerv(GL_SAMPLER_BINDING, &s->sampler[i]);
+        glBindSampler((GLuint)i, 0);
     }
+    glGetIntegerv(GL_TRANSFORM_FEEDBACK_BINDING, &s->tf_object);
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
     glGetIntegerv(GL_BLEND_SRC_RGB, &s->blend_src_rgb);
     glGetIntegerv(GL_BLEND_DST_RGB, &s->blend_dst_rgb);
     glGetIntegerv(GL_BLEND_SRC_ALPHA, &s->blend_src_a);
@@ -440,6 +447,9 @@ static void gl_capture(gl_saved *s)
     glGetBooleanv(GL_DEPTH_WRITEMASK, &s->depth_mask);
     glGetBooleanv(GL_COLOR_WRITEMASK, s->color_mask);
     glGetFloatv(GL_DEPTH_CLEAR_VALUE, &s->depth_clear);
+    glGetFloatv(GL_DEPTH_RANGE, s->depth_range);
+    glGetFloatv(GL_COLOR_CLEAR_VALUE, s->clear_color);
+    glDepthRangef(0.0f, 1.0f);  // the renderer reconstructs points from depths in 0..1
     s->blend = glIsEnabled(GL_BLEND);
     s->depth_test = glIsEnabled(GL_DEPTH_TEST);
     s->scissor_test = glIsEnabled(GL_SCISSOR_TEST);
@@ -480,7 +490,9 @@ static void gl_restore(const gl_saved *s)
     for (int i = 0; i < RS_RENDER_TEXTURE_UNITS; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         for (int t = 0; t < 3; t++) glBindTexture(texture_targets[t].target, (GLuint)s->tex[i][t]);
+        glBindSampler((GLuint)i, (GLuint)s->sampler[i]);
     }
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, (GLuint)s->tf_object);
     glActiveTexture((GLenum)s->active_texture);
     glBlendFuncSeparate((GLenum)s->blend_src_rgb, (GLenum)s->blend_dst_rgb, (GLenum)s->blend_src_a,
                         (GLenum)s->blend_dst_a);
@@ -488,6 +500,8 @@ static void gl_restore(const gl_saved *s)
     glDepthFunc((GLenum)s->depth_func);
     glDepthMask(s->depth_mask);
     glClearDepthf(s->depth_clear);
+    glDepthRangef(s->depth_range[0], s->depth_range[1]);
+    glClearColor(s->clear_color[0], s->clear_color[1], s->clear_color[2], s->clear_color[3]);
     glColorMask(s->color_mask[0], s->color_mask[1], s->color_mask[2], s->color_mask[3]);
     for (int i = 0; i < PIXEL_STORE_COUNT; i++) glPixelStorei(pixel_store[i].name, s->pixel_store[i]);
     gl_enable(GL_BLEND, s->blend);

@@ -83,13 +83,22 @@ static void test_zero_view_is_the_default_view(void)
     rs_image_free(&b);
 }
 
-// A host's framebuffer with odd state everywhere; rouge_face_draw must render into its viewport and
-// leave all of it as it found it.
+// A host's framebuffer with odd state everywhere; rouge_face_draw must render into its viewport, draw the
+// picture it draws without that state (a host's sampler objects once overrode the renderer's shadow
+// comparison and filtering: 4059 pixels off), and leave all of it as it found it (the clear colour was
+// left black by the visibility pass).
 static void test_draw_into_host_framebuffer_restores_state(void)
 {
     rouge_view v = small_view();
-    v.width = v.height = 0;  // the viewport's size
     rouge_error e = {0};
+    // The picture without the host's state: the frame drawn under it must be this one to the byte.
+    rs_image clean = {0};
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
+    bool have_clean = frame(&clean);
+    v.yaw_deg += 1.0f;  // another frame between, so that the draw below renders again
+    RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK && rouge_face_render(face, &e) == ROUGE_OK, "%s", e.msg);
+    v.yaw_deg -= 1.0f;
+    v.width = v.height = 0;  // the viewport's size
     RS_REQUIRE(rouge_face_set_view(face, &v, &e) == ROUGE_OK, "%s", e.msg);
     GLuint tex, fbo, vao, buf, tex3;
     glGenTextures(1, &tex);
@@ -115,6 +124,19 @@ static void test_draw_into_host_framebuffer_restores_state(void)
         glActiveTexture(GL_TEXTURE0 + (GLenum)u);
         for (int t = 0; t < 3; t++) glBindTexture(targets[t], host_tex[u][t]);
     }
+    // A sampler object on every unit (it overrides a texture's own filtering and comparison), a depth
+    // range, a clear colour and a transform feedback object of the host's.
+    GLuint sampler, tfo;
+    glGenSamplers(1, &sampler);
+    glSamplerParameteri(sampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glSamplerParameteri(sampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glSamplerParameterf(sampler, GL_TEXTURE_MAX_LOD, 0.0f);
+    glSamplerParameteri(sampler, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+    glSamplerParameteri(sampler, GL_TEXTURE_COMPARE_FUNC, GL_NEVER);
+    for (int u = 0; u < UNITS; u++) glBindSampler((GLuint)u, sampler);
+    glDepthRangef(0.25f, 0.75f);
+    glGenTransformFeedbacks(1, &tfo);
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, tfo);
     glDeleteTextures(1, &host_tex[3][0]);
     glGenTextures(1, &tex3);
     glActiveTexture(GL_TEXTURE3);
@@ -169,6 +191,22 @@ static void test_draw_into_host_framebuffer_restores_state(void)
     }
     glActiveTexture(GL_TEXTURE3);
     RS_CHECK(lost == 0, "%d of the host's %d texture bindings lost", lost, UNITS * 3);
+    int samplers_lost = 0;
+    for (int u = 0; u < UNITS; u++) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)u);
+        glGetIntegerv(GL_SAMPLER_BINDING, &i);
+        samplers_lost += i != (GLint)sampler;
+    }
+    glActiveTexture(GL_TEXTURE3);
+    RS_CHECK(samplers_lost == 0, "%d of the host's %d sampler bindings lost", samplers_lost, UNITS);
+    GLfloat f4[4];
+    glGetFloatv(GL_DEPTH_RANGE, f4);
+    RS_CHECK(f4[0] == 0.25f && f4[1] == 0.75f, "depth range %g %g", f4[0], f4[1]);
+    glGetFloatv(GL_COLOR_CLEAR_VALUE, f4);
+    RS_CHECK(f4[0] == 1.0f && f4[1] == 0.0f && f4[2] == 1.0f && f4[3] == 1.0f, "clear colour %g %g %g %g", f4[0],
+             f4[1], f4[2], f4[3]);
+    glGetIntegerv(GL_TRANSFORM_FEEDBACK_BINDING, &i);
+    RS_CHECK(i == (GLint)tfo, "transform feedback object %d, host had %u", i, tfo);
     glGetIntegerv(GL_PACK_ALIGNMENT, &i);
     RS_CHECK(i == 8, "pack alignment");
     RS_CHECK(glGetError() == GL_NO_ERROR, "GL error after draw");
@@ -191,6 +229,9 @@ static void test_draw_into_host_framebuffer_restores_state(void)
                 bad += !ok;
             }
         RS_CHECK(bad == 0, "%d pixels of the host framebuffer differ from the face's frame / the host's clear", bad);
+        if (have_clean)
+            RS_CHECK(changed_pixels(&want, &clean) == 0, "the frame drawn under the host's state differs from the "
+                     "clean one by more than 2 levels in %d pixels", changed_pixels(&want, &clean));
     }
     free(px);
     rs_image_free(&want);
@@ -204,6 +245,12 @@ static void test_draw_into_host_framebuffer_restores_state(void)
     glDeleteFramebuffers(1, &fbo);
     glDeleteTextures(1, &tex);
     glDeleteTextures(UNITS * 3, &host_tex[0][0]);  // tex3 among them
+    for (int u = 0; u < UNITS; u++) glBindSampler((GLuint)u, 0);
+    glDeleteSamplers(1, &sampler);
+    glBindTransformFeedback(GL_TRANSFORM_FEEDBACK, 0);
+    glDeleteTransformFeedbacks(1, &tfo);
+    glDepthRangef(0.0f, 1.0f);
+    rs_image_free(&clean);
 }
 
 static rouge_error stroke_err;  // why the last stroke() failed
