@@ -135,7 +135,7 @@ typedef enum rs_render_stage {
     RS_STAGE_VISIBILITY,
     RS_STAGE_ATTRIBUTE,
     RS_STAGE_DIFFUSION,
-    RS_STAGE_COMPOSITE,
+    RS_STAGE_COMPOSITE,  // with its last step, the contours inside the face anti-aliased (rs_render_edges)
     RS_STAGE_COUNT
 } rs_render_stage;
 
