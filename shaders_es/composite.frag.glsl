@@ -54,6 +54,7 @@ uniform int u_tonemap;          // 0: filmic, 1: clamp (the paper's figures)
 uniform mat4 u_inv_view;        // view -> model (flakes are fixed on the surface)
 uniform float u_flake_size;     // model units
 uniform float u_contour_reach;  // view units (20 mm): a surface this close behind a contour hides its rim
+uniform int u_outline_coverage; // 1: the outline's 3x3 coverage here; 0: the edges pass anti-aliases it
 
 out vec4 o_color;
 
@@ -207,7 +208,9 @@ bool fill_hole(ivec2 px, out vec4 t0, out vec4 t1, out vec4 t2, out vec4 t3, out
     return k >= 6;
 }
 
-// Anti-aliased silhouette: a face pixel that touches the background (in its 3x3 neighbourhood) is drawn
+// The outline's coverage where the edges pass does not take it (u_outline_coverage: the sharp_contours
+// views; edges.frag.glsl follows the outline along its runs, which a 3x3 rule cannot): a face pixel that
+// touches the background (in its 3x3 neighbourhood) is drawn
 // with coverage n / 8 for its n face pixels there (itself included), the background showing through the
 // rest: a straight edge's last pixel at 3/4, the outer corner of a stair step at 1/2, an inner corner
 // whole, a stray pixel outside the edge gone. A mask pixel's centre is on the face, so the edge runs
@@ -340,13 +343,13 @@ void main()
     vec4 D;
     float alpha = 1.0;
     if (t0.a > u_min_weight && rs_visible_point(p)) {
-        alpha = coverage(px);
+        if (u_outline_coverage == 1) alpha = coverage(px);
         t1 = texelFetch(u_attr1, px, 0);
         t2 = texelFetch(u_attr2, px, 0);
         t3 = u_env_on > 0.5 ? texelFetch(u_attr3, px, 0) : vec4(0.0);  // written under an environment only
         D = texelFetch(u_diffuse, px, 0);
     } else if (!fill_hole(px, t0, t1, t2, t3, p, D)) {
-        o_color = vec4(u_background, 1.0);
+        o_color = vec4(u_background, 0.0);  // alpha 0: background, for the edges pass (the output's is 1)
         return;
     }
     float inv = 1.0 / t0.a;

@@ -1,8 +1,7 @@
 #version 300 es
 // edges.frag.glsl — the end of stage 5: anti-aliasing of the depth steps inside the face (the lip line, the
-// nose's base, eyelids, the jaw over the neck). The composite draws each pixel as the one surface its centre
-// sees, so a contour in front of more face is a one-pixel staircase; the silhouette has its own coverage
-// (composite.frag.glsl). As in morphological anti-aliasing (Reshetov 2009), each step between a pixel and a
+// nose's base, eyelids, the jaw over the neck) and of the face's outline. The composite draws each pixel as
+// the one surface its centre sees, so a contour is a one-pixel staircase. As in morphological anti-aliasing (Reshetov 2009), each step between a pixel and a
 // 4-neighbour (edges_find.frag.glsl) is followed along the contour to both ends of its straight run; the
 // contour is taken to pass through the middles of the risers there, and the share of the pixel on the other
 // side of that line shows the other side's colour (mixed in linear light). The steps come from the depth,
@@ -79,7 +78,7 @@ vec3 to_output(vec3 c)
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy);
-    vec4 own = texelFetch(u_color, px, 0);
+    vec4 own = vec4(texelFetch(u_color, px, 0).rgb, 1.0);  // the composite's alpha marks the background
     o_color = own;
     const ivec2 dirs[4] = ivec2[4](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
     vec4 sum = vec4(0.0);
@@ -88,7 +87,7 @@ void main()
         float w = share(px, dirs[i]);
         if (w <= 0.0) continue;
         vec4 c = texelFetch(u_color, px + dirs[i], 0);
-        sum += w * vec4(to_linear(c.rgb), c.a);
+        sum += w * vec4(to_linear(c.rgb), 1.0);
         total += w;
     }
     if (total <= 0.0) return;

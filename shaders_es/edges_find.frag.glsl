@@ -3,15 +3,15 @@
 // whether the surface steps back or forward to its right neighbour (R) and to the one above it (G):
 // 0 no step, 0.5 the neighbour is deeper, 1 it is nearer. A step is a contour when it is deeper than
 // u_step_min and than the surfaces' own slopes on either side (a surface seen edge-on changes depth fast
-// too, but evenly); the background is no step here (the silhouette has its own coverage). Also copies the
-// composite's picture to the output, and writes depth 0 where the pixel has a step to any 4-neighbour
-// (1 elsewhere), so that the edges pass shades only those.
+// too, but evenly); between the face and the background (the composite's alpha 0) the outline is a step
+// too. Also copies the composite's picture to the output (alpha 1), and writes depth 0 where the pixel
+// has a step to any 4-neighbour (1 elsewhere), so that the edges pass shades only those.
 precision highp float;
 precision highp int;
 #define RS_NEEDS_VISIBLE_POINT 1
 #include "splat_ray.glsl"
 
-uniform highp sampler2D u_color;  // the composite's picture
+uniform highp sampler2D u_color;  // the composite's picture, alpha 0 on the background
 uniform float u_step_min;         // view units
 uniform int u_enabled;            // 0: no steps (views of data, tests of the composite)
 
@@ -51,21 +51,37 @@ float step_to(ivec2 px, ivec2 n, float b)
     return c > b ? 0.5 : 1.0;
 }
 
+// The step from px to px + n as step_to codes it; face: the composite drew skin at px (its alpha), z its
+// depth (-1: a gap the composite filled). The background is deeper than any face: the outline is a step.
+float step_code(ivec2 px, ivec2 n, bool face, float z)
+{
+    ivec2 q = px + n;
+    if (any(lessThan(q, ivec2(0))) || any(greaterThanEqual(q, ivec2(u_viewport)))) return 0.0;
+    bool qface = texelFetch(u_color, q, 0).a > 0.5;
+    if (face != qface) return face ? 0.5 : 1.0;
+    return face && z >= 0.0 ? step_to(px, n, z) : 0.0;
+}
+
 void main()
 {
     ivec2 px = ivec2(gl_FragCoord.xy), x = ivec2(1, 0), y = ivec2(0, 1);
-    o_color = texelFetch(u_color, px, 0);
+    vec4 own = texelFetch(u_color, px, 0);
+    o_color = vec4(own.rgb, 1.0);
     o_step = vec2(0.0);
     gl_FragDepth = 1.0;
+    if (u_enabled == 0) return;
+    bool face = own.a > 0.5;
     float z = pushed_depth_at(px);
-    if (u_enabled == 0 || z < 0.0) return;
-    // Most pixels: no neighbour further than a step could be, pushes (which differ by up to RS_PUSH_MAX
-    // u_eps) included.
     vec4 n = vec4(pushed_depth_at(px + x), pushed_depth_at(px - x), pushed_depth_at(px + y), pushed_depth_at(px - y));
-    bvec4 far = greaterThan(abs(n - z), vec4(u_step_min - RS_PUSH_MAX * u_eps));
-    if (!any(far) && !any(lessThan(n, vec4(0.0)))) return;
-    z = depth_at(px);
-    o_step = vec2(step_to(px, x, z), step_to(px, y, z));
+    // Most pixels: background among background, or face whose neighbours are no further than a step could
+    // be, pushes (which differ by up to RS_PUSH_MAX u_eps) included.
+    if (!face && all(lessThan(n, vec4(0.0)))) return;
+    if (face && z >= 0.0 && all(greaterThanEqual(n, vec4(0.0))) &&
+        !any(greaterThan(abs(n - z), vec4(u_step_min - RS_PUSH_MAX * u_eps))))
+        return;
+    if (z >= 0.0) z = depth_at(px);
+    o_step = vec2(step_code(px, x, face, z), step_code(px, y, face, z));
     // The steps to the left and below are those neighbours' (their R and G): found again here.
-    if (o_step != vec2(0.0) || step_to(px, -x, z) != 0.0 || step_to(px, -y, z) != 0.0) gl_FragDepth = 0.0;
+    if (o_step != vec2(0.0) || step_code(px, -x, face, z) != 0.0 || step_code(px, -y, face, z) != 0.0)
+        gl_FragDepth = 0.0;
 }

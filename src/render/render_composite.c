@@ -9,6 +9,15 @@
 
 #include <math.h>
 
+// Whether the edges pass anti-aliases the frame: not the views of data (normals, regions, LOD levels and
+// the shadow factor show each pixel's own, unmixed) nor rs_view.sharp_contours.
+static bool edges_on(const rs_frame *f)
+{
+    rs_render_mode m = f->view.mode;
+    bool data = m == RS_MODE_NORMALS || m == RS_MODE_REGIONS || m == RS_MODE_LOD || m == RS_MODE_SHADOW;
+    return !data && !f->view.sharp_contours;
+}
+
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
 {
     GLuint prog;
@@ -34,6 +43,8 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     // Below a pixel even in a 3x close-up (~0.2 mm): a pixel sums a few to hundreds of them.
     glUniform1f(rs_uloc(prog, "u_flake_size"), 0.060f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
     glUniform1f(rs_uloc(prog, "u_contour_reach"), 20.0f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
+    // The outline's coverage: the edges pass's when it runs, else the composite's 3x3 rule.
+    glUniform1i(rs_uloc(prog, "u_outline_coverage"), edges_on(f) ? 0 : 1);
     rs_render_env_uniforms(r, f, prog);
     // Under an environment the highlight is what skin's surface reflects, white (a dielectric); the
     // paper's A (D + S) tints it with the albedo, which the paper's figures keep.
@@ -95,10 +106,7 @@ rs_result rs_render_edges(rs_renderer *r, const rs_frame *f, rs_error *err)
     glUniform1f(rs_uloc(find, "u_eps"), f->eps);
     // Half a millimetre: the lip line's step, the smallest contour that draws a staircase.
     glUniform1f(rs_uloc(find, "u_step_min"), 0.5f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
-    // The views of data (normals, regions, LOD levels) show each pixel's own, unmixed.
-    rs_render_mode m = f->view.mode;
-    bool data = m == RS_MODE_NORMALS || m == RS_MODE_REGIONS || m == RS_MODE_LOD;
-    glUniform1i(rs_uloc(find, "u_enabled"), data || f->view.sharp_contours ? 0 : 1);
+    glUniform1i(rs_uloc(find, "u_enabled"), edges_on(f) ? 1 : 0);
     rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
     rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
     rs_render_bind_texture(RS_UNIT_COLOR, r->pre_tex);
