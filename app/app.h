@@ -19,9 +19,9 @@ const char *rs_app_default_face(char *buf, size_t n);
 // Headless: load the face, apply --look / --strokes, render the view to cli->output (atomic PNG write).
 rs_result rs_app_render(const rs_cli *cli, rs_error *err);
 // The face's current view drawn n times wider and taller (the same camera: framing does not depend on the
-// size) and averaged down in linear light into out (RGBA): a still whose edges inside the face (the lip
-// line over the lower lip, the nose's base; the renderer anti-aliases only the silhouette) look as a
-// camera's pixels would. The face keeps the larger view: set it back before the next frame.
+// size) and averaged down in linear light into out (RGBA): a still whose every pixel, highlights and the
+// splats' detail included, is the mean of n x n samples, as a camera's would be (the renderer's own
+// anti-aliasing reaches its contours only). The face keeps the larger view: set it back before the next frame.
 rs_result rs_app_render_supersampled(rouge_face *face, int n, rs_image *out, rs_error *err);
 // The command line's view (every field explicit) as the public API's view.
 rouge_view rs_app_public_view(const rs_view *v, const char *env);

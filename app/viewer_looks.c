@@ -202,8 +202,8 @@ void vw_looks_export(vw_viewer *v)
     char png[1100], look[1100];
     export_paths(L->export_path, png, sizeof png, look, sizeof look);
     // The current look at full quality, without the split or the UI: the face's view (its last frame's)
-    // drawn at twice the size and averaged down (rs_app_render_supersampled: the lip line and the nose's
-    // base without the one-pixel steps the screen shows), then the view set back and drawn again. A window
+    // drawn at twice the size and averaged down (rs_app_render_supersampled: every pixel four samples,
+    // highlights included), then the view set back and drawn again. A window
     // past 16 megapixels supersampled (4K and up: a software GL keeps its targets in CPU memory) exports
     // the frame on screen as it is.
     rouge_view keep = rouge_face_get_view(v->face);

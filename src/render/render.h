@@ -109,7 +109,7 @@ typedef struct rs_view {
     float env_intensity;        // multiplies the environment (after its normalisation); 0 means 1
     rs_tonemap tonemap;
     bool linear_output;         // debug/tests: write linear values (no sRGB encoding, clamped to 0..1)
-    bool sharp_contours;        // tests: no anti-aliasing of the depth steps inside the face (the composite's own)
+    bool sharp_contours;        // tests: no edges pass (one surface per pixel; the outline the composite's 3x3 rule)
     // A host's camera instead of the orbit one (yaw, pitch, zoom, fov, pan ignored): model -> eye (rigid)
     // and a perspective eye -> clip, column-major (rouge.h rouge_view.use_matrices; checked by the caller).
     bool use_matrices;
@@ -135,7 +135,7 @@ typedef enum rs_render_stage {
     RS_STAGE_VISIBILITY,
     RS_STAGE_ATTRIBUTE,
     RS_STAGE_DIFFUSION,
-    RS_STAGE_COMPOSITE,  // with its last step, the contours inside the face anti-aliased (rs_render_edges)
+    RS_STAGE_COMPOSITE,  // with its last step, the contours anti-aliased (rs_render_edges)
     RS_STAGE_COUNT
 } rs_render_stage;
 

@@ -32,7 +32,7 @@ typedef enum rs_prog {
     RS_PROG_RESOLVE = RS_PROG_SPLAT_COUNT,
     RS_PROG_COMPOSITE,
     RS_PROG_IRRADIANCE,     // transform feedback: per-splat irradiance for stage 4
-    RS_PROG_EDGES_FIND,     // stage 5's end: the depth steps inside the face (and the picture copied),
+    RS_PROG_EDGES_FIND,     // stage 5's end: the contours' steps (and the picture copied),
     RS_PROG_EDGES,          // then the steps anti-aliased
     RS_PROG_COUNT
 } rs_prog;

@@ -18,8 +18,9 @@ int rs_render_diffusion_plan(rs_renderer *r, const rs_frame *f, rs_diffusion_lev
 rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                               rs_error *err);
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err);
-// The composite's last step: its picture with the depth steps inside the face anti-aliased, into the
-// output. An output pixel reads its 4-neighbours' colours and the steps along its contours.
+// The composite's last step: its picture with its contours (the depth steps inside the face, the outline)
+// anti-aliased, into the output. An output pixel reads its 4-neighbours' colours and the steps along its
+// contours.
 rs_result rs_render_edges(rs_renderer *r, const rs_frame *f, rs_error *err);
 
 // Lookups a pass sets on its programs. render_shadow.c: the shadow_lookup.glsl uniforms for the frame.
