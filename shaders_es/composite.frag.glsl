@@ -17,6 +17,7 @@ precision highp int;
 #include "bounce.glsl"
 #include "tangent_basis.glsl"
 #include "makeup_fine.glsl"
+#include "skin_seen.glsl"
 
 // Same numbering as rs_render_mode in render.h.
 #define MODE_FULL 0
@@ -29,26 +30,22 @@ precision highp int;
 #define MODE_LOD 7
 #define MODE_IRRADIANCE 8
 
-uniform highp sampler2D u_attr0;
 uniform highp sampler2D u_attr1;
 uniform highp sampler2D u_attr2;
 uniform highp sampler2D u_attr3;
 uniform float u_bent_scale;     // RT3's weights relative to RT0's (attribute.frag.glsl)
-uniform highp sampler2D u_diffuse;
+uniform highp usampler2D u_reflect;  // the face blocking the mirror direction, at half size (reflect.frag.glsl)
 uniform int u_mode;
 uniform int u_physical;         // 1: F = A D + S
 uniform float u_exposure;
 uniform float u_linear_output;  // 1: no sRGB encoding (tests of the composite's algebra)
 uniform vec3 u_background;      // already in the output encoding
 uniform float u_rho_s_scale;
-uniform float u_diffuse_scale;  // undoes the D target's scale (RGBA8 fallback)
-uniform vec3 u_delta_weight;    // profile weight of the Gaussians too narrow to draw: per-pixel irradiance
 uniform vec3 u_key_dir;
 uniform vec3 u_key_color;
 uniform vec3 u_fill_dir;
 uniform vec3 u_fill_color;
 uniform vec3 u_ambient;
-uniform float u_min_weight;     // accumulated weights below this are unreliable (RGBA8 fallback): a hole
 uniform float u_key_widen;      // the key light's angular radius / 2: added in quadrature to m (area light)
 uniform int u_tonemap;          // 0: filmic, 1: clamp (the paper's figures)
 uniform mat4 u_inv_view;        // view -> model (flakes are fixed on the surface)
@@ -247,54 +244,50 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
     return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
 }
 
-// Whether the face itself blocks the mirror direction R (view space) from the surface point p. The
-// environment's radiance is looked up as if every direction above the surface's horizon saw the sky; AO
-// only scales it by the share of the sky the point sees in all. But a head is a closed solid: a reflection
-// that runs back past the face's own surface (the side of the nose mirroring a lamp behind the subject,
-// through the cheek and the eye socket) sees the inside of the head, not the lamp; the path tracer shows
-// no highlight there and rouge drew a white streak down the nose at the physical strength (issue 22). So
-// R is marched 2.5 to 80 mm (steps doubling: an ear's folds are a few mm deep) through the depth buffer: a point that lies behind the visible
-// surface at its pixel by more than 1-3 mm (and less than a head's depth: beyond that the ray passes
-// behind the head) is inside the head and blocks the reflection. Background leaves it open. hit: the pixel
-// of the surface that blocks it most; left: the march ran off the frame, past what the depth buffer knows
-// (the caller asks the splat's bent cone then).
-float reflection_open(vec3 p, vec3 R, inout ivec2 hit, out bool left)
+
+// Whether the face itself blocks the mirror direction (reflect.frag.glsl's march, at half size), averaged
+// over the pixel and 8 around it at 1 mm (at least 4 px) that lie on its surface (within 1 mm of its tangent
+// plane and 5 mm of it) and mirror about its way: one pixel's march ends in a sharp edge where its step's
+// projection crosses a blocker's contour, a line that the lobe's width blurs. open: the share the march
+// left open; left: the march that counts most ran off the frame; blocked: the skin the blocked share sees.
+ivec2 reflection_sample(ivec2 px, int i, float mm)
 {
-    left = false;
-    float open = 1.0;
-    float d = 0.125 * u_contour_reach;
-    // The march's points in clip space are linear in d: no projection per step.
-    vec4 cp = u_proj * vec4(p, 1.0), cr = u_proj * vec4(R, 0.0);
-    for (int k = 0; k < 6; k++, d *= 2.0) {
-        vec3 q = p + R * d;
-        if (q.z > -1e-3) break;  // passes the eye's plane: in front of everything the camera sees
-        vec4 c = cp + cr * d;
-        vec2 f = (c.xy / c.w * 0.5 + 0.5) * u_viewport;
-        if (any(lessThan(f, vec2(0.0))) || any(greaterThanEqual(f, u_viewport))) {
-            left = true;
-            break;
-        }
-        vec3 s;
-        if (!rs_visible_point_at(rs_depth_pixel(f), s)) continue;
-        float behind = s.z - q.z;
-        float o = 1.0 - smoothstep(0.05 * u_contour_reach, 0.15 * u_contour_reach, behind)
-                        * (1.0 - smoothstep(8.0 * u_contour_reach, 10.0 * u_contour_reach, behind));
-        if (o < open) open = o, hit = rs_depth_pixel(f);
-    }
-    return open;
+    float a = float(i) * 0.78539816;
+    vec2 off = i == 8 ? vec2(0.0) : mm * vec2(cos(a), sin(a));
+    return clamp(px + ivec2(round(off)), ivec2(0), ivec2(u_viewport) - 1) / 2;
 }
 
-// What a reflection that the face itself blocks sees instead of the sky: the skin it runs into, at the
-// pixel hit (the nearest surface behind a contour, the one a marched reflection passes behind), as the
-// camera sees it diffusely there, A D (the narrowest levels' share taken at their luminance). Black
-// before: at the chin's edge over the neck that drew a dark line where the path tracer shows the neck's
-// reflection, reddish at grazing Fresnel (issue 22).
-vec3 skin_at(ivec2 q)
+void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool left, out vec3 blocked)
 {
-    vec4 a = texelFetch(u_attr0, q, 0);
-    if (a.a <= u_min_weight) return vec3(0.0);
-    vec4 d = texelFetch(u_diffuse, q, 0) * u_diffuse_scale;
-    return a.rgb / a.a * (d.rgb + u_delta_weight * d.a);
+    open = 1.0, blocked = vec3(0.0), left = false;
+    // 1 mm here in pixels (u_contour_reach is 20 mm), within 4..16 px (2..8 of the march's).
+    float mm = clamp(u_proj[1][1] * 0.5 * u_viewport.y / -p.z * u_contour_reach / 20.0, 4.0, 16.0);
+    vec2 half_size = vec2(textureSize(u_reflect, 0));
+    float w_sum = 0.0, o_sum = 0.0, w_left = 0.0;
+    for (int i = 8; i >= 0; i--) {  // the pixel's own sample first
+        ivec2 t = reflection_sample(px, i, mm);
+        uvec4 r = texelFetch(u_reflect, t, 0);
+        if (r.x == 0u) continue;  // no surface there
+        float o = unpackHalf2x16(r.z).y;
+        bool l = o >= 2.0;
+        o -= l ? 2.0 : 0.0;
+        // Its point: on the ray through the full-size pixel at its centre, at its depth.
+        vec2 ndc = (floor((vec2(t) + 0.5) / half_size * u_viewport) + 0.5) / u_viewport * 2.0 - 1.0;
+        vec4 h = u_inv_proj * vec4(ndc, -1.0, 1.0);
+        vec3 s = h.xyz / h.w * (uintBitsToFloat(r.x) / (h.z / h.w)), d = s - p;
+        if (abs(dot(d, N)) > 0.05 * u_contour_reach || dot(d, d) > 0.0625 * u_contour_reach * u_contour_reach) continue;
+        // Its mirror direction within the lobe's width of this one's (at a rim it turns fast).
+        vec3 nq = rs_from_octahedral(unpackSnorm2x16(r.w));
+        float w = smoothstep(0.95, 0.99, dot(reflect(normalize(s), nq), R));
+        // The nearest march counts a little whatever it mirrors: at a rim, where the normal turns fast
+        // and no other does, it decides alone.
+        if (i == 8) w = max(w, 0.01);
+        o_sum += o * w, w_sum += w;
+        if (w > w_left) w_left = w, left = l;
+        blocked += vec3(unpackHalf2x16(r.y), unpackHalf2x16(r.z).x) * w;
+    }
+    if (w_sum == 0.0) return;
+    open = o_sum / w_sum, blocked /= w_sum;
 }
 
 // How far the normal turns across this pixel (radians): the larger of its changes to the next pixel right
@@ -391,11 +384,12 @@ void main()
             // Sky occlusion stands in for the specular's visibility too (eye sockets, nostrils), and at
             // contours the surface just behind them.
             float ndotv = dot(N, V);
-            ivec2 hit_c = ivec2(-1), hit_r = ivec2(-1);
+            ivec2 hit_c = ivec2(-1);
             float open_c = contour_open(p, N, ndotv, 1.0 - smoothstep(0.1, 0.5, ndotv), hit_c);
+            float open_r;
             bool left;
-            vec3 Rv = reflect(-V, N);
-            float open_r = reflection_open(p, Rv, hit_r, left);
+            vec3 Rv = reflect(-V, N), blocked_r;
+            reflection_near(px, p, N, Rv, open_r, left, blocked_r);
             vis = rs_env_lamp_visibility(p, N);
             spread = normal_spread(px, N);
             vec3 B = N;  // the bent normal (RT3), where the splats carry one
@@ -413,7 +407,9 @@ void main()
             float open_cone = 1.0;
             if (left && u_has_bent > 0.5) {
                 float ct = sqrt(max(1.0 - ao, 0.0));
-                open_cone = smoothstep(ct - 0.1, ct + 0.1, dot(Rv, B));
+                // A cone of nearly the whole hemisphere (ao near 1) closes nothing: it fades in as ao
+                // goes from 1 to 0.99, not below a splat's horizon at once.
+                open_cone = 1.0 - (1.0 - smoothstep(ct - 0.1, ct + 0.1, dot(Rv, B))) * smoothstep(0.0, 0.1, ct);
             }
             float so = ao * open_c * open_r * open_cone;
             E += rs_env_sky(N, B, ao) + rs_env_lamp_irradiance(N, vis);
@@ -422,21 +418,20 @@ void main()
             Eb = rs_bounce(ao, A);
             // The lobe's share the occlusion hides (1 - ao) reflects that skin too, not black: Eb is its
             // radiance over the hidden share, (1 - ao) L_skin, so that share adds Eb times the lobe's albedo
-            // (under the jaw: the lit neck; its shares below come to 1 with so and the blocked (wc + wr) ao).
+            // (under the jaw: the lit neck; its shares below come to 1 with so and the blocked ones times ao).
             float lobe = rho_s * rs_env_lobe_albedo(max(ndotv, 1e-4), m, RS_F0_SKIN);
             S += Eb * lobe;
             // The map's reflection and the lamps' (those as their shadow maps let them through; the sky
             // occlusion too, as for the map: the lamps' maps are too coarse for an ear's folds, issue 22).
             S += (rs_env_specular(N, V, m, RS_F0_SKIN) + rs_env_lamp_specular(N, V, m, RS_F0_SKIN, vis, spread))
                  * (rho_s * so);
-            // Where the face blocks it, the reflection shows the skin it runs into: the blocker that takes
-            // the larger share (one lookup of a distant pixel, not two: on a GPU they cost an eighth of the
-            // environment's time), and only where the share is worth one (a few % of a reflection that is a
-            // few % of the skin's light is below a level of the output).
-            float wc = 1.0 - open_c, wr = open_c * (1.0 - open_r);
-            ivec2 hit = wc >= wr ? hit_c : hit_r;
-            if (wc + wr > 0.02 && hit.x >= 0)
-                S += skin_at(hit) * ((wc + wr) * ao * lobe);
+            // Where the face blocks it, the reflection shows the skin it runs into: behind a contour (only
+            // where that share is worth a lookup: a few % of a reflection that is a few % of the skin's light
+            // is below a level of the output) and where the march found it blocked (reflection_near).
+            float wc = 1.0 - open_c;
+            vec3 blocked = open_c * blocked_r;
+            if (wc > 0.02 && hit_c.x >= 0) blocked += skin_at(hit_c) * wc;
+            S += blocked * (ao * lobe);
             float wk = open_c * open_r * (1.0 - open_cone);
             if (wk > 0.0) S += rs_hidden_radiance(ao, A) * (wk * ao * lobe);
             if (coat > 0.0)

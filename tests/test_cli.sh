@@ -89,7 +89,7 @@ no_file cli_fifo_input_leaves_no_output "$tmp/h.png"
 expect cli_size_does_not_wrap 2 "--size: expected WxH" "$rouge" render "$face" -o "$tmp/i.png" --size 4294967312x16
 no_file cli_size_wrap_leaves_no_output "$tmp/i.png"
 # Memory: the frame size is bounded by what its render targets cost, said in the error.
-expect cli_size_bounded_by_target_memory 1 "needs about 4.5 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
+expect cli_size_bounded_by_target_memory 1 "needs about 4.7 GiB of render targets" "$rouge" render "$face" -o "$tmp/m.png" --size 8192x8192
 no_file cli_size_memory_leaves_no_output "$tmp/m.png"
 expect cli_supersample_out_of_range 2 "--supersample: 5 is out of range 1..4" "$rouge" render "$face" -o "$tmp/s.png" --supersample 5
 expect cli_supersample_over_max_size 2 "--supersample 3: 4000x4000 would be drawn at 12000x12000" \

@@ -114,7 +114,7 @@ out:
 // brightest pixel facing the eye; before: 148 against 45). Its edge-on pixels that face sideways mirror
 // the cheek beside and behind them, not the studio's side lamps: the path tracer shows no sheen there
 // (tests/test_truth.c), and with the skin's physical specular strength a white streak ran down the nose's
-// side until the head blocked its own reflections (composite.frag.glsl reflection_open): their p90 stays
+// side until the head blocked its own reflections (reflect.frag.glsl reflection_open): their p90 stays
 // at or below the facing pixels' p95, while the facing pixels keep their sheen (p95 >= 20: not every
 // reflection blocked).
 static void check_rim(rouge_pipeline pipeline, const char *name)

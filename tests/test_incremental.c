@@ -2,7 +2,7 @@
 // renderer redraws only the attribute and composite passes inside the rectangle the changed splats cover,
 // over the last frame's depth, shadow map and diffusion. After a long random sequence of stamps (several
 // products, an eraser, mirror strokes), each followed by a frame, the picture equals a from-scratch frame
-// within 1/255 everywhere, in both pipelines, with float and RGBA8 targets.
+// within 1/255 everywhere, in both pipelines, with float and RGBA8 targets, and under an environment.
 // And the splats' irradiance kept across views: once the lights have held still for a frame, stage 4 reuses
 // the per-splat light of every splat for any view (orbiting, another side of the head) until a light moves;
 // each such frame equals a fresh renderer's of the same view and light within 1/255, under an environment
@@ -28,13 +28,21 @@ static uint32_t rng(uint32_t *s)
     return *s;
 }
 
-static void run(rs_pipeline pipeline, bool rgba8)
+// env: under an environment (the reflections the face blocks see the painted skin), else the paper's lamp.
+static void run(rs_pipeline pipeline, bool rgba8, const char *env_name)
 {
     rs_renderer *r = NULL;
     rs_makeup *mk = NULL;
+    rs_env *env = NULL;
     rs_error err = {0};
     RS_REQUIRE(rs_render_create(&(rs_render_desc){.cloud = face, .caps = rs_gl_get_caps(gl), .force_no_float_targets = rgba8},
                                 &r, &err) == RS_OK, "%s", err.msg);
+    if (env_name && !RS_CHECK(rs_env_open(env_name, "assets/env", &env, &err) == RS_OK &&
+                                  rs_render_set_env(r, env, &err) == RS_OK, "%s", err.msg)) {
+        rs_env_destroy(env);
+        rs_render_destroy(r);
+        return;
+    }
     if (!RS_CHECK(rs_makeup_create(face, NULL, &mk, &err) == RS_OK, "%s", err.msg)) {
         rs_render_destroy(r);
         return;
@@ -84,8 +92,9 @@ static void run(rs_pipeline pipeline, bool rgba8)
             worst = RS_MAX(worst, dd);
             changed += dd > 1;
         }
-        printf("# %s, %s targets: %u of %d frames incremental; largest difference from a full frame %d/255\n",
-               pipeline == RS_PIPELINE_MOBILE ? "mobile" : "reference", rgba8 ? "RGBA8" : "float", incs, STAMPS, worst);
+        printf("# %s, %s targets, %s: %u of %d frames incremental; largest difference from a full frame %d/255\n",
+               pipeline == RS_PIPELINE_MOBILE ? "mobile" : "reference", rgba8 ? "RGBA8" : "float",
+               env_name ? env_name : "lamp", incs, STAMPS, worst);
         RS_CHECK(incs == STAMPS, "only %u of %d frames were incremental", incs, STAMPS);
         RS_CHECK(worst <= 1, "incremental differs from a full frame by up to %d/255 (%d values)", worst, changed);
         if (worst > 1) {
@@ -97,6 +106,7 @@ static void run(rs_pipeline pipeline, bool rgba8)
     rs_image_free(&b);
     rs_makeup_destroy(mk);
     rs_render_destroy(r);
+    rs_env_destroy(env);
 }
 
 // A fresh renderer's picture of view v (nothing kept from other frames).
@@ -182,10 +192,11 @@ static void test_kept_irradiance(void)
     rs_env_destroy(env);
 }
 
-static void test_incremental_mobile_float(void) { run(RS_PIPELINE_MOBILE, false); }
-static void test_incremental_mobile_rgba8(void) { run(RS_PIPELINE_MOBILE, true); }
-static void test_incremental_reference_float(void) { run(RS_PIPELINE_REFERENCE, false); }
-static void test_incremental_reference_rgba8(void) { run(RS_PIPELINE_REFERENCE, true); }
+static void test_incremental_mobile_float(void) { run(RS_PIPELINE_MOBILE, false, NULL); }
+static void test_incremental_mobile_rgba8(void) { run(RS_PIPELINE_MOBILE, true, NULL); }
+static void test_incremental_reference_float(void) { run(RS_PIPELINE_REFERENCE, false, NULL); }
+static void test_incremental_reference_rgba8(void) { run(RS_PIPELINE_REFERENCE, true, NULL); }
+static void test_incremental_mobile_environment(void) { run(RS_PIPELINE_MOBILE, false, "studio"); }
 
 int main(int argc, char **argv)
 {
@@ -204,6 +215,7 @@ int main(int argc, char **argv)
     RS_RUN(test_incremental_mobile_rgba8);
     RS_RUN(test_incremental_reference_float);
     RS_RUN(test_incremental_reference_rgba8);
+    RS_RUN(test_incremental_mobile_environment);
     RS_RUN(test_kept_irradiance);
     rs_splat_destroy(face);
     rs_gl_destroy(gl);

@@ -7,6 +7,7 @@
 #include "support/face_fixture.h"
 #include "render/render.h"
 #include "core/image.h"
+#include "formats/env.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -309,6 +310,94 @@ static void test_contours_and_outline_are_anti_aliased(void)
 {
     contour_is_anti_aliased(true);
     contour_is_anti_aliased(false);
+}
+
+// A reflection the face blocks (the upper lip's underside mirroring the lower lip in front of it): sheet A
+// (green) faces down and forward, sheet B (red) stands REFL_Z mm in front of it below, so A's mirror
+// directions run into B up to some height on A. Each step of the composite's march decides "blocked" at
+// one pixel, so the blocked region ended in a sharp line, a copy of B's top edge shifted by the step's
+// projection (thin light lines along the upper lip). Under an environment, in the specular view, the
+// blocked share must fade in over the lobe's width: along each column of A, no pixel-to-pixel change may
+// exceed a quarter of the whole change from blocked to open (measured 0.14; before: 0.75).
+#define REFL_S 0.4f
+#define REFL_Z 25.0f
+static rs_splat_cloud *make_ledge(void)
+{
+    enum { NX = 51, NA = 76, NB = 51 };
+    rs_splat *s = calloc(NX * (NA + NB), sizeof *s);
+    if (!s) return NULL;
+    int n = 0;
+    for (int sheet = 0; sheet < 2; sheet++)
+        for (int j = 0; j < (sheet ? NB : NA); j++)
+            for (int i = 0; i < NX; i++) {
+                rs_splat *p = &s[n++];
+                float x = (float)(i - (NX - 1) / 2) * REFL_S, v = (float)j * REFL_S;
+                p->pos[0] = x;
+                if (sheet == 0) {  // A: down its slope from B's lower edge, normal (0, 0.6, 0.8)
+                    p->pos[1] = -0.8f * v, p->pos[2] = 0.6f * v;
+                    p->normal[1] = 0.6f, p->normal[2] = 0.8f;
+                } else {  // B: up from its lower edge, facing the camera
+                    p->pos[1] = v, p->pos[2] = REFL_Z;
+                    p->normal[2] = 1.0f;
+                }
+                p->radius = 1.5f * REFL_S;
+                p->rgb[sheet ? 0 : 1] = 200;
+            }
+    return scene_cloud(s, n, 50.0f);
+}
+
+static void test_blocked_reflection_fades_in_over_the_lobe(void)
+{
+    rs_splat_cloud *ledge = make_ledge();
+    rs_renderer *r = scene_renderer(ledge);
+    if (!r) return;
+    rs_error err = {0};
+    rs_env *env = NULL;
+    rs_image spec = {0}, alb = {0};
+    rs_view v = test_view(RS_MODE_SPECULAR);
+    v.max_splats = 0;
+    v.no_shadows = true;  // B's shadow on A is another sharp edge
+    bool ok = RS_CHECK(rs_env_load("assets/env/daylight.rse", &env, &err) == RS_OK, "%s", err.msg) &&
+              RS_CHECK(rs_render_set_env(r, env, &err) == RS_OK, "%s", err.msg) && rs_test_render(r, &v, &spec);
+    v.mode = RS_MODE_ALBEDO;
+    ok = ok && rs_test_render(r, &v, &alb);
+    if (ok) {
+        double worst = 0, sum_range = 0;
+        int cols = 0;
+        for (int x = SIZE / 3; x < 2 * SIZE / 3; x += 4) {
+            // A's pixels down the column, 3 px clear of its contours (B's lower edge, the background).
+            double l[SIZE];
+            int n = 0, y = 0;
+            while (y < SIZE - 1 && !(px(&alb, x, y)[1] > 100 && px(&alb, x, y)[0] < 50)) y++;
+            for (y += 3; y < SIZE - 1; y++) {
+                bool a = true;
+                for (int k = -3; k <= 3 && a; k++) {
+                    const uint8_t *q = px(&alb, x, RS_CLAMP(y + k, 0, SIZE - 1));
+                    a = q[1] > 100 && q[0] < 50;
+                }
+                if (!a) break;
+                const uint8_t *q = px(&spec, x, y);
+                l[n++] = 0.2126 * srgb_channel(q[0]) + 0.7152 * srgb_channel(q[1]) + 0.0722 * srgb_channel(q[2]);
+            }
+            double lo = 1e9, hi = -1e9, jump = 0;
+            for (int i = 0; i < n; i++) {
+                lo = fmin(lo, l[i]), hi = fmax(hi, l[i]);
+                if (i) jump = fmax(jump, fabs(l[i] - l[i - 1]));
+            }
+            if (n < 20 || hi - lo < 1e-3) continue;
+            worst = fmax(worst, jump / (hi - lo)), sum_range += hi - lo, cols++;
+        }
+        printf("# blocked reflection: %d columns, change blocked to open %.3f (linear), largest step between two "
+               "pixels %.2f of it\n", cols, sum_range / RS_MAX(cols, 1), worst);
+        RS_CHECK(cols > 10 && sum_range / cols > 0.02, "the scene shows no blocked reflection (%d columns)", cols);
+        if (!RS_CHECK(worst < 0.25, "the blocked share jumps by %.2f of its change between two pixels", worst))
+            rs_test_save("render_ledge_specular", &spec);
+    }
+    rs_image_free(&spec);
+    rs_image_free(&alb);
+    rs_env_destroy(env);
+    rs_render_destroy(r);
+    rs_splat_destroy(ledge);
 }
 
 static void test_points_and_quads_give_the_same_image(void)
@@ -824,6 +913,7 @@ int main(int argc, char **argv)
     RS_RUN(test_points_and_quads_give_the_same_image);
     RS_RUN(test_fold_edge_shows_the_surface_behind);
     RS_RUN(test_contours_and_outline_are_anti_aliased);
+    RS_RUN(test_blocked_reflection_fades_in_over_the_lobe);
     RS_RUN(test_specular_energy_doubles_with_rho_s);
     RS_RUN(test_composite_is_albedo_times_diffuse_plus_specular);
     RS_RUN(test_rgba8_fallback_is_close_to_float_targets);

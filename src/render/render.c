@@ -149,17 +149,17 @@ rs_result rs_render_create(const rs_render_desc *desc, rs_renderer **out, rs_err
 
 static void release_targets(rs_renderer *r)
 {
-    GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_diffuse, r->fbo_pre, r->fbo_edges, r->fbo_out};
+    GLuint fbos[] = {r->fbo_vis, r->fbo_attr, r->fbo_diffuse, r->fbo_reflect, r->fbo_pre, r->fbo_edges, r->fbo_out};
     glDeleteFramebuffers((GLsizei)RS_COUNT_OF(fbos), fbos);
     GLuint texs[] = {r->depth_tex, r->push_tex, r->diffuse_tex, r->pre_tex, r->out_steps_tex[0], r->out_steps_tex[1],
-                     r->mask_tex};
+                     r->mask_tex, r->reflect_tex};
     glDeleteTextures((GLsizei)RS_COUNT_OF(texs), texs);
     glDeleteTextures(RS_ATTR_TARGETS, r->attr_tex);
     rs_render_level_release(r);
-    r->fbo_vis = r->fbo_attr = r->fbo_diffuse = r->fbo_pre = r->fbo_edges = r->fbo_out = 0;
+    r->fbo_vis = r->fbo_attr = r->fbo_diffuse = r->fbo_reflect = r->fbo_pre = r->fbo_edges = r->fbo_out = 0;
     r->depth_tex = r->push_tex = 0;
     memset(r->attr_tex, 0, sizeof r->attr_tex);
-    r->diffuse_tex = r->pre_tex = r->out_steps_tex[0] = r->out_steps_tex[1] = r->mask_tex = 0;
+    r->diffuse_tex = r->pre_tex = r->out_steps_tex[0] = r->out_steps_tex[1] = r->mask_tex = r->reflect_tex = 0;
     r->tw = r->th = 0;
     r->have_frame = false;
     r->inc_valid = false;
@@ -201,14 +201,14 @@ static GLuint fbo_with(const GLuint *colour, int ncolour, GLuint depth)
     return fbo;
 }
 
-// Render targets of a w x h frame: depth and its push, four attribute targets, diffuse, the composite's
-// picture, the output (the picture's depth steps anti-aliased), the steps and their mask, the
-// reduced-resolution diffusion levels (at most 4/3 of one accumulation target) and the ID buffer (R32UI +
-// depth). llvmpipe keeps all of it in CPU memory, so this is what a frame size costs the machine.
+// Render targets of a w x h frame: depth and its push, four attribute targets, diffuse, the reflections'
+// blocking (half size, 16 B), the composite's picture, the output (the picture's depth steps
+// anti-aliased), the steps and their mask, the reduced-resolution diffusion levels (at most 4/3 of one
+// accumulation target) and the ID buffer (R32UI + depth). llvmpipe keeps all of it in CPU memory, so this is what a frame size costs the machine.
 static double target_estimate(int w, int h, bool float_rt)
 {
     double px = (double)w * h, acc = float_rt ? 8 : 4;
-    return px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + 4 + 2 + 2 + acc * 4.0 / 3.0 + 8);
+    return px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + 4 + 4 + 2 + 2 + acc * 4.0 / 3.0 + 8);
 }
 
 static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
@@ -227,6 +227,7 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
     // The bent normal's target is RGBA8 whatever the others are (attribute.frag.glsl).
     for (int i = 0; i < RS_ATTR_TARGETS; i++) r->attr_tex[i] = rs_render_texture(i < 3 ? acc : GL_RGBA8, w, h);
     r->diffuse_tex = rs_render_texture(acc, w, h);
+    r->reflect_tex = rs_render_texture(GL_RGBA32UI, (w + 1) / 2, (h + 1) / 2);
     r->pre_tex = rs_render_texture(GL_RGBA8, w, h);
     r->out_steps_tex[0] = rs_render_texture(GL_RGBA8, w, h);
     r->out_steps_tex[1] = rs_render_texture(GL_RG8, w, h);
@@ -243,6 +244,7 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
         {&r->fbo_vis, &r->push_tex, 1, r->depth_tex, "visibility target", "DEPTH_COMPONENT32F + R8"},
         {&r->fbo_attr, r->attr_tex, RS_ATTR_TARGETS, r->depth_tex, "attribute targets", acc_name},
         {&r->fbo_diffuse, &r->diffuse_tex, 1, 0, "diffuse target", acc_name},
+        {&r->fbo_reflect, &r->reflect_tex, 1, 0, "reflections target", "RGBA32UI, half size"},
         {&r->fbo_pre, &r->pre_tex, 1, 0, "composite target", "RGBA8"},
         {&r->fbo_edges, r->out_steps_tex, 2, r->mask_tex, "depth steps targets", "RGBA8 + RG8 + DEPTH_COMPONENT16"},
         {&r->fbo_out, r->out_steps_tex, 1, r->mask_tex, "output target", "RGBA8 + DEPTH_COMPONENT16"},
@@ -267,8 +269,10 @@ static rs_result ensure_targets(rs_renderer *r, int w, int h, rs_error *err)
 static size_t target_bytes(const rs_renderer *r)
 {
     size_t px = (size_t)r->tw * (size_t)r->th, acc = r->float_rt ? 8 : 4;
-    // depth, push, attributes, D, the composite's picture, the output, its steps and their mask
-    size_t bytes = px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + 4 + 2 + 2);
+    // depth, push, attributes, D, the reflections' blocking, the composite's picture, the output, its
+    // steps and their mask
+    size_t bytes = px * (4 + 1 + (RS_ATTR_TARGETS - 1) * acc + 4 + acc + 4 + 4 + 2 + 2) +
+                   (size_t)((r->tw + 1) / 2) * (size_t)((r->th + 1) / 2) * 16;
     for (int i = 0; i < RS_LEVEL_DIVS; i++)
         if (r->level_tex[i]) bytes += px * acc >> (2 * i);
     return bytes;
@@ -351,7 +355,8 @@ static void clear_dirty(rs_renderer *r)
     r->dirty[2] = r->dirty[3] = -INFINITY;
 }
 
-// Stages 3 and 5 again inside the dirty rectangle, over the last frame's depth, shadow map and D.
+// Stages 3 and 5 again inside the dirty rectangle (the reflections' pass a little around it), over the
+// last frame's depth, shadow map and D.
 static rs_result incremental_frame(rs_renderer *r, rs_frame *f, rs_error *err)
 {
     float *d = r->dirty, w = (float)f->cam.width, h = (float)f->cam.height;
@@ -370,6 +375,10 @@ static rs_result incremental_frame(rs_renderer *r, rs_frame *f, rs_error *err)
         rs_diffusion_level levels[RS_PROFILE_MAX];
         rs_render_diffusion_plan(r, f, levels, f->delta_weight);  // the per-pixel weights; D stays
     }
+    // The skin the face's blocked reflections see there was painted too.
+    const int rect[4] = {x0, y0, x1, y1};
+    if (res == RS_OK) res = rs_render_reflections(r, f, rect, err);
+    glScissor(x0, y0, x1 - x0, y1 - y0);
     if (res == RS_OK) res = rs_render_composite(r, f, err);
     // An output pixel mixes its 4-neighbours' colours.
     glScissor(x0 - 1, y0 - 1, x1 - x0 + 2, y1 - y0 + 2);
@@ -444,6 +453,7 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     }
     stage_mark(r, RS_STAGE_DIFFUSION, &t);
     if (res == RS_OK) res = stage_hook(r, RS_STAGE_COMPOSITE, err);
+    if (res == RS_OK) res = rs_render_reflections(r, &f, NULL, err);
     if (res == RS_OK) res = rs_render_composite(r, &f, err);
     if (res == RS_OK) res = rs_render_edges(r, &f, err);
     stage_mark(r, RS_STAGE_COMPOSITE, &t);

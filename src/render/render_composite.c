@@ -18,6 +18,41 @@ static bool edges_on(const rs_frame *f)
     return !data && !f->view.sharp_contours;
 }
 
+rs_result rs_render_reflections(rs_renderer *r, const rs_frame *f, const int *rect, rs_error *err)
+{
+    if (!f->env_on) return RS_OK;
+    GLuint prog;
+    rs_result res = rs_render_program(r, RS_PROG_REFLECT, false, &prog, err);
+    if (res != RS_OK) return res;
+    const rs_camera *cam = &f->cam;
+    // At half size: the composite averages it over a millimetre around each pixel anyway.
+    int w = (cam->width + 1) / 2, h = (cam->height + 1) / 2;
+    glBindFramebuffer(GL_FRAMEBUFFER, r->fbo_reflect);
+    glViewport(0, 0, w, h);
+    // A composite pixel averages what lies up to 16 px around it (composite.frag.glsl reflection_near).
+    if (rect)
+        glScissor((rect[0] - 16) / 2, (rect[1] - 16) / 2, (rect[2] - rect[0] + 34) / 2, (rect[3] - rect[1] + 34) / 2);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(prog);
+    glUniformMatrix4fv(rs_uloc(prog, "u_proj"), 1, GL_FALSE, (const float *)cam->proj);
+    glUniformMatrix4fv(rs_uloc(prog, "u_inv_proj"), 1, GL_FALSE, (const float *)cam->inv_proj);
+    glUniform2f(rs_uloc(prog, "u_viewport"), (float)w, (float)h);
+    glUniform1f(rs_uloc(prog, "u_eps"), f->eps);
+    glUniform1f(rs_uloc(prog, "u_contour_reach"), 20.0f / RS_MAX(r->cloud->hdr.mm_per_unit, 1e-6f));
+    glUniform1f(rs_uloc(prog, "u_min_weight"), r->float_rt ? 0.0f : RS_MIN_WEIGHT_RGBA8);
+    glUniform1f(rs_uloc(prog, "u_diffuse_scale"), r->float_rt ? 1.0f : 1.0f / RS_DIFFUSE_SCALE_RGBA8);
+    glUniform3fv(rs_uloc(prog, "u_delta_weight"), 1, f->delta_weight);
+    rs_render_bind_texture(RS_UNIT_DEPTH, r->depth_tex);
+    rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
+    rs_render_bind_texture(RS_UNIT_ATTR0, r->attr_tex[0]);
+    rs_render_bind_texture(RS_UNIT_ATTR1, r->attr_tex[1]);
+    rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
+    glBindVertexArray(r->vao_empty);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    return RS_OK;
+}
+
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
 {
     GLuint prog;
@@ -76,11 +111,13 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     rs_render_bind_texture(RS_UNIT_PUSH, r->push_tex);
     for (int i = 0; i < RS_ATTR_TARGETS; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
     rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
+    rs_render_bind_texture(RS_UNIT_REFLECT, f->env_on ? r->reflect_tex : 0);
     rs_render_fine_uniforms(r, f, prog);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
     for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_FINE_INDEX; i++) rs_render_bind_texture(i, 0);
+    rs_render_bind_texture(RS_UNIT_REFLECT, 0);
     rs_render_fine_unbind();
     return RS_OK;
 }

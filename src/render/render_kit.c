@@ -41,6 +41,7 @@ static const char *const prog_files[RS_PROG_COUNT][2] = {
     [RS_PROG_ATTRIBUTE] = {"attribute.vert.glsl", "attribute.frag.glsl"},
     [RS_PROG_DIFFUSION] = {"diffusion.vert.glsl", "diffusion.frag.glsl"},
     [RS_PROG_RESOLVE] = {"fullscreen.vert.glsl", "diffusion_resolve.frag.glsl"},
+    [RS_PROG_REFLECT] = {"fullscreen.vert.glsl", "reflect.frag.glsl"},
     [RS_PROG_COMPOSITE] = {"fullscreen.vert.glsl", "composite.frag.glsl"},
     [RS_PROG_IRRADIANCE] = {"irradiance.vert.glsl", "irradiance.frag.glsl"},
     [RS_PROG_EDGES_FIND] = {"fullscreen.vert.glsl", "edges_find.frag.glsl"},
@@ -101,6 +102,7 @@ rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *ou
     glUniform1i(rs_uloc(p, "u_spec_lut"), RS_UNIT_SPEC_LUT);
     glUniform1i(rs_uloc(p, "u_color"), RS_UNIT_COLOR);
     glUniform1i(rs_uloc(p, "u_edges"), RS_UNIT_EDGES);
+    glUniform1i(rs_uloc(p, "u_reflect"), RS_UNIT_REFLECT);
     glUniform1f(rs_uloc(p, "u_has_ao"), (h->flags & RS_SPLAT_FLAG_AO) ? 1.0f : 0.0f);
     glUniform1f(rs_uloc(p, "u_has_bent"), (h->flags & RS_SPLAT_FLAG_BENT) ? 1.0f : 0.0f);
     r->prog[kind][q] = p;

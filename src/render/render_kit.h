@@ -30,6 +30,7 @@ typedef enum rs_prog {
     RS_PROG_DIFFUSION,
     RS_PROG_SPLAT_COUNT,
     RS_PROG_RESOLVE = RS_PROG_SPLAT_COUNT,
+    RS_PROG_REFLECT,        // stage 5's first pass: the face blocking the mirror direction
     RS_PROG_COMPOSITE,
     RS_PROG_IRRADIANCE,     // transform feedback: per-splat irradiance for stage 4
     RS_PROG_EDGES_FIND,     // stage 5's end: the contours' steps (and the picture copied),
@@ -56,6 +57,7 @@ enum {
     RS_UNIT_LAMP_SHADOW, // the environment's other lamps' shadow maps, one atlas (u_lamp_shadow_map)
     RS_UNIT_COLOR,       // the composite's picture before its contours are anti-aliased (u_color)
     RS_UNIT_EDGES,       // the depth steps in it (u_edges, RG8)
+    RS_UNIT_REFLECT,     // the face blocking the mirror direction (u_reflect, RGBA32UI, half size)
     RS_UNIT_COUNT
 };
 _Static_assert(RS_UNIT_COUNT <= RS_RENDER_TEXTURE_UNITS, "render.h's RS_RENDER_TEXTURE_UNITS");
@@ -233,7 +235,8 @@ struct rs_renderer {
     GLuint pre_tex;             // the composite's picture, before its contours are anti-aliased
     GLuint out_steps_tex[2];    // the output, and the depth steps in it (RG8; edges_find.frag.glsl)
     GLuint mask_tex;            // depth 0 where a pixel has a step: the edges pass shades only those
-    GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_pre, fbo_edges, fbo_out;
+    GLuint reflect_tex;         // the face blocking the mirror direction, half size (RGBA32UI; reflect.frag.glsl)
+    GLuint fbo_vis, fbo_attr, fbo_diffuse, fbo_reflect, fbo_pre, fbo_edges, fbo_out;
     GLuint level_tex[RS_LEVEL_DIVS], fbo_level[RS_LEVEL_DIVS];  // full, half, quarter size; made on first use
     bool have_frame;
     // What the splats' light reads besides the frame's lights: bumped by every shadow map drawn and every

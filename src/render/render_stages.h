@@ -17,6 +17,10 @@ int rs_render_diffusion_plan(rs_renderer *r, const rs_frame *f, rs_diffusion_lev
                              float delta_weight[3]);
 rs_result rs_render_diffusion(rs_renderer *r, const rs_frame *f, const rs_diffusion_level *levels, int count,
                               rs_error *err);
+// The composite's first step, at half size: whether the face blocks each pixel's mirror direction and the
+// skin it sees there (under an environment only). rect (x0, y0, x1, y1; NULL: all): the pixels an
+// incremental frame composes again, with the scissor test on; it leaves the scissor box changed.
+rs_result rs_render_reflections(rs_renderer *r, const rs_frame *f, const int *rect, rs_error *err);
 rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err);
 // The composite's last step: its picture with its contours (the depth steps inside the face, the outline)
 // anti-aliased, into the output. An output pixel reads its 4-neighbours' colours and the steps along its
