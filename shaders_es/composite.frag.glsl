@@ -34,7 +34,7 @@ uniform highp sampler2D u_attr1;
 uniform highp sampler2D u_attr2;
 uniform highp sampler2D u_attr3;
 uniform float u_bent_scale;     // RT3's weights relative to RT0's (attribute.frag.glsl)
-uniform highp usampler2D u_reflect;  // the face blocking the mirror direction, at half size (reflect.frag.glsl)
+uniform highp usampler2D u_reflect;  // the face blocking reflections, half size (reflect.frag.glsl)
 uniform int u_mode;
 uniform int u_physical;         // 1: F = A D + S
 uniform float u_exposure;
@@ -244,12 +244,7 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
     return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
 }
 
-
-// Whether the face itself blocks the mirror direction (reflect.frag.glsl's march, at half size), averaged
-// over the pixel and 8 around it at 1 mm (at least 4 px) that lie on its surface (within 1 mm of its tangent
-// plane and 5 mm of it) and mirror about its way: one pixel's march ends in a sharp edge where its step's
-// projection crosses a blocker's contour, a line that the lobe's width blurs. open: the share the march
-// left open; left: the march that counts most ran off the frame; blocked: the skin the blocked share sees.
+// The reflections' texel of sample i around pixel px: 0..7 on a circle of mm pixels, 8 the pixel itself.
 ivec2 reflection_sample(ivec2 px, int i, float mm)
 {
     float a = float(i) * 0.78539816;
@@ -257,6 +252,12 @@ ivec2 reflection_sample(ivec2 px, int i, float mm)
     return clamp(px + ivec2(round(off)), ivec2(0), ivec2(u_viewport) - 1) / 2;
 }
 
+// Whether the face itself blocks the mirror direction R (reflect.frag.glsl's march, at half size),
+// averaged over the pixel and 8 around it at 1 mm (at least 4 px) that lie on its surface (within 1 mm of
+// its tangent plane and 5 mm of it) and mirror about its way: one pixel's march ends in a sharp edge where
+// its step's projection crosses a blocker's contour, a line that the lobe's width blurs. open: the share
+// the march left open; left: the march that counts most ran off the frame; blocked: the skin the blocked
+// share sees.
 void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool left, out vec3 blocked)
 {
     open = 1.0, blocked = vec3(0.0), left = false;
@@ -275,7 +276,8 @@ void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool 
         vec2 ndc = (floor((vec2(t) + 0.5) / half_size * u_viewport) + 0.5) / u_viewport * 2.0 - 1.0;
         vec4 h = u_inv_proj * vec4(ndc, -1.0, 1.0);
         vec3 s = h.xyz / h.w * (uintBitsToFloat(r.x) / (h.z / h.w)), d = s - p;
-        if (abs(dot(d, N)) > 0.05 * u_contour_reach || dot(d, d) > 0.0625 * u_contour_reach * u_contour_reach) continue;
+        if (abs(dot(d, N)) > 0.05 * u_contour_reach || dot(d, d) > 0.0625 * u_contour_reach * u_contour_reach)
+            continue;
         // Its mirror direction within the lobe's width of this one's (at a rim it turns fast).
         vec3 nq = rs_from_octahedral(unpackSnorm2x16(r.w));
         float w = smoothstep(0.95, 0.99, dot(reflect(normalize(s), nq), R));

@@ -312,13 +312,14 @@ static void test_contours_and_outline_are_anti_aliased(void)
     contour_is_anti_aliased(false);
 }
 
-// A reflection the face blocks (the upper lip's underside mirroring the lower lip in front of it): sheet A
-// (green) faces down and forward, sheet B (red) stands REFL_Z mm in front of it below, so A's mirror
-// directions run into B up to some height on A. Each step of the composite's march decides "blocked" at
-// one pixel, so the blocked region ended in a sharp line, a copy of B's top edge shifted by the step's
-// projection (thin light lines along the upper lip). Under an environment, in the specular view, the
-// blocked share must fade in over the lobe's width: along each column of A, no pixel-to-pixel change may
-// exceed a quarter of the whole change from blocked to open (measured 0.14; before: 0.75).
+// A reflection the face blocks (on a lip close-up, the upper lip's underside mirroring the lower lip in
+// front of it; here turned over so that the open directions see the sky): sheet A (green) faces up and
+// forward, sheet B (red) stands REFL_Z mm in front of it and above, so A's mirror directions run into B
+// down to some depth on A. Each step of the reflections' march decides "blocked" at one pixel, so the
+// blocked region ended in a sharp line, a copy of B's lower edge shifted by the step's projection (thin
+// light lines along the upper lip). Under an environment, in the specular view, the blocked share must fade
+// in over the lobe's width: along each column of A, no pixel-to-pixel change may exceed a quarter of the
+// whole change from blocked to open (measured 0.20; before: 0.75).
 #define REFL_S 0.4f
 #define REFL_Z 25.0f
 static rs_splat_cloud *make_ledge(void)

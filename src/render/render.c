@@ -204,7 +204,8 @@ static GLuint fbo_with(const GLuint *colour, int ncolour, GLuint depth)
 // Render targets of a w x h frame: depth and its push, four attribute targets, diffuse, the reflections'
 // blocking (half size, 16 B), the composite's picture, the output (the picture's depth steps
 // anti-aliased), the steps and their mask, the reduced-resolution diffusion levels (at most 4/3 of one
-// accumulation target) and the ID buffer (R32UI + depth). llvmpipe keeps all of it in CPU memory, so this is what a frame size costs the machine.
+// accumulation target) and the ID buffer (R32UI + depth). llvmpipe keeps all of it in CPU memory, so
+// this is what a frame size costs the machine.
 static double target_estimate(int w, int h, bool float_rt)
 {
     double px = (double)w * h, acc = float_rt ? 8 : 4;
