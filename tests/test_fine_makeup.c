@@ -582,9 +582,11 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
     // splats' a* about their Otsu cut, over 3 mm) and fills it within the brush's reach (makeup_fine.glsl).
     // The truth is the albedo's border (lips_truth), so lighting does not move it; against the lit
     // picture's truth the same painted pixels had moved from 94.4 / 96.6 %, spill 5.6 % to 93.6 / 96.4 %,
-    // 9.7 % when the bounce light came. Measured now: 96.9 / 96.1 %, spill 0.40 %, wander 0.18 / 0.49 px
-    // (moving averages 0.70 / 2.04 px; with all 600k splats drawn 96.2 / 96.1 %, 0.36 %); the former field (a* +-12, cut at Otsu's, the region's border
-    // cutting the lower lip) measured 88.9 / 91.9 %, 0.38 %, wander against the moving average 0.67 / 1.66.
+    // 9.7 % when the bounce light came. Measured now (2026-11-28): 96.9 / 95.6 %, spill 0.21 %, wander
+    // 0.23 / 0.50 px (moving averages 0.69 / 2.09 px; first measured 96.9 / 96.1 %, 0.40 %, 0.18 / 0.49 px;
+    // then with all 600k splats drawn 96.2 / 96.1 %, 0.36 %); the former field (a* +-12, cut at Otsu's, the
+    // region's border cutting the lower lip) measured 88.9 / 91.9 %, 0.38 %, wander against the moving
+    // average 0.67 / 1.66.
     // lipstick_lips_3x_truth.png shows the border (green), lip left uncovered (blue), the mouth line no
     // lipstick reaches (magenta, not counted) and spill (yellow).
     RS_CHECK(cu >= 0.95 && cl >= 0.95,
