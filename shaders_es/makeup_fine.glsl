@@ -46,6 +46,18 @@ float rs_fine_falloff(float u, float hard)
     return (exp(-2.0 * u * u) - rim) / (1.0 - rim);
 }
 
+// makeup.c rs_makeup_facing: how much of a stamp made from view direction v (not normalised; 0: no test)
+// reaches a surface of unit normal n.
+#define RS_FINE_FACING_FULL 0.3  // RS_MAKEUP_FACING_FULL
+float rs_fine_facing(vec3 n, vec3 v, bool whole)
+{
+    float vl = length(v);
+    if (vl <= 0.0) return 1.0;
+    float d = dot(n, v);
+    if (d <= 0.0) return 0.0;
+    return whole ? 1.0 : smoothstep(0.0, RS_FINE_FACING_FULL * vl, d);
+}
+
 // A region mask's weight at model-space point pm: its field interpolated there (the voxel centres are
 // the texel centres), ramped linearly over the band around the threshold. 1 where the region has no field.
 float rs_fine_region_weight(int region, vec3 pm)
@@ -136,14 +148,14 @@ void rs_fine_apply(vec3 pm, vec3 nm, inout vec3 albedo, inout float m, inout flo
             rs_fine_stack(l, best, product, eraser, touches);
             stroke = t2.y, best = 0.0, reached = false;
         }
-        float vl = length(t1.xyz);
         int reg = int(t2.w);
-        // RS_MAKEUP_FACING_MIN; a product kept to a region only needs the surface to face the view at all:
-        // its mask, not the grazing angle, bounds it (the lips roll into the mouth line at a grazing angle).
-        if (vl > 0.0 && dot(nm, t1.xyz) <= (reg != 0 ? 0.0 : 0.2) * vl) continue;
         product = int(t2.x), eraser = t2.z > 0.5;
+        // A product kept to a region only needs the surface to face the view at all: its mask, not the
+        // grazing angle, bounds it (the lips roll into the mouth line at a grazing angle).
+        float facing = rs_fine_facing(nm, t1.xyz, eraser || reg != 0);
+        if (facing <= 0.0) continue;
         vec4 pr = rs_fine_texel(u_fine_products + 3 * product + 2);
-        float ig = rs_fine_falloff(length(pm - t0.xyz) / t0.w, eraser ? 0.0 : pr.w);
+        float ig = rs_fine_falloff(length(pm - t0.xyz) / t0.w, eraser ? 0.0 : pr.w) * facing;
         if (reg != 0 && ig > 0.0) {
             if (reg != region) region = reg, region_w = rs_fine_region_weight(reg, pm);
             // Kept to a region, the stroke fills it up to the mask within the brush's reach, as a lipstick

@@ -190,6 +190,57 @@ static void test_liner_is_one_crisp_even_dark_line_on_both_sides(void)
     rouge_face_clear(face, &e);
 }
 
+// A narrow line drawn in the front view across the cheek and off the face's side, seen from that side
+// (yaw -70): where the cheek turns from the view it was drawn in, the line fades out over the last ~17 deg
+// before edge-on (makeup_fine.glsl rs_fine_facing) instead of ending in a cut. Per column of the side
+// view, the line's strength is its largest drop of luminance over the bare picture's, relative to that
+// (the ink's share, whatever the light there). A sheer product (a narrow blush line): an opaque pencil
+// saturates and shows the fade only in its last few degrees.
+static void test_narrow_line_fades_out_where_the_cheek_turns_away(void)
+{
+    rouge_error e = {0};
+    const int w = 512, h = 512;
+    rouge_face_clear(face, &e);
+    rouge_view front = {.width = w, .height = h, .max_splats = 300000}, side = front;
+    side.yaw_deg = -70.0f;
+    uint8_t *bare = NULL, *paint = NULL, *scratch = NULL;
+    RS_REQUIRE(rouge_face_set_view(face, &side, &e) == ROUGE_OK, "view: %s", e.msg);
+    RS_REQUIRE(render(w, h, &bare), "bare side render");
+    rouge_face_set_view(face, &front, &e);
+    RS_REQUIRE(render(w, h, &scratch), "front render");  // the pointer's frame
+    RS_REQUIRE(rouge_face_set_brush(face, &(rouge_brush){.cosmetic = "blush", .size = 0.012f, .opacity = 1.0f,
+                                                         .any_region = true}, &e) == ROUGE_OK, "brush: %s", e.msg);
+    stroke(0.36f * w, 0.58f * h, 0.02f * w, 0.58f * h, 80);
+    rouge_face_set_view(face, &side, &e);
+    RS_REQUIRE(render(w, h, &paint), "painted side render");
+    save("line_cheek_side", paint, w, h);
+    double p[512] = {0}, peak = 0;
+    for (int x = w / 2; x < w; x++) {
+        for (int y = 0; y < h; y++) {
+            size_t i = ((size_t)y * w + x) * 4;
+            double lb = lum(bare + i);
+            if (lb > 20.0) p[x] = fmax(p[x], (lb - lum(paint + i)) / lb);
+        }
+        peak = fmax(peak, p[x]);
+    }
+    // The line's end towards the ear (image left in this view; the stroke's dots on the ear itself, which
+    // faces the front view, lie left of w / 2): from its first column at 3 % of the peak to the first at
+    // 40 % (measured: 31 px; the former cut at N.V 0.2: 2 px).
+    int first = -1, at40 = -1;
+    for (int x = w / 2; x < w && at40 < 0; x++) {
+        if (first < 0 && p[x] >= 0.03 * peak) first = x;
+        if (p[x] >= 0.4 * peak) at40 = x;
+    }
+    printf("# narrow line off the cheek, seen from the side: the line takes %.0f %% of the skin's luminance at "
+           "most; towards the ear it fades from 40 %% of that to nothing over %d px (columns %d..%d)\n",
+           100.0 * peak, at40 - first, first, at40);
+    RS_CHECK(peak > 0.05, "the line darkens the skin by %.0f %% at most (no line?)", 100.0 * peak);
+    RS_CHECK(first >= 0 && at40 - first >= 6, "the line ends within %d px where the cheek turns away: a cut, not "
+             "a fade", at40 - first);
+    free(bare), free(paint), free(scratch);
+    rouge_face_clear(face, &e);
+}
+
 // Writes tests/fixtures/strokes/lips.strokes with another cosmetic into the test folder; its path.
 static const char *lips_strokes_with(const char *cosmetic)
 {
@@ -582,7 +633,7 @@ static void test_lipstick_fills_each_lip_to_its_border_without_spill(void)
     // splats' a* about their Otsu cut, over 3 mm) and fills it within the brush's reach (makeup_fine.glsl).
     // The truth is the albedo's border (lips_truth), so lighting does not move it; against the lit
     // picture's truth the same painted pixels had moved from 94.4 / 96.6 %, spill 5.6 % to 93.6 / 96.4 %,
-    // 9.7 % when the bounce light came. Measured now (2026-11-28): 96.9 / 95.6 %, spill 0.21 %, wander
+    // 9.7 % when the bounce light came. Measured now (2026-11-28): 96.7 / 95.6 %, spill 0.21 %, wander
     // 0.23 / 0.50 px (moving averages 0.69 / 2.09 px; first measured 96.9 / 96.1 %, 0.40 %, 0.18 / 0.49 px;
     // then with all 600k splats drawn 96.2 / 96.1 %, 0.36 %); the former field (a* +-12, cut at Otsu's, the
     // region's border cutting the lower lip) measured 88.9 / 91.9 %, 0.38 %, wander against the moving
@@ -667,6 +718,7 @@ int main(int argc, char **argv)
         return 1;
     }
     RS_RUN(test_liner_is_one_crisp_even_dark_line_on_both_sides);
+    RS_RUN(test_narrow_line_fades_out_where_the_cheek_turns_away);
     RS_RUN(test_gloss_over_lipstick_reads_in_the_default_front_view);
     RS_RUN(test_highlighter_is_a_sheen_without_specks);
     RS_RUN(test_lipstick_fills_each_lip_to_its_border_without_spill);

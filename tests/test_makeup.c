@@ -601,6 +601,51 @@ static void test_facing_test_keeps_stamp_off_the_far_side(void)
     rs_splat_destroy(c);
 }
 
+// A brush pressed from the front glances off a surface turning away: a blush stroke towards a cheek's
+// side must fade out there, not stop at a line (the former facing test cut it off at N.V 0.2, a hard
+// edge seen from the side), and the surface facing away stays bare. A half cylinder about y (19 mm
+// radius, a splat per degree), the stamp at 75 deg from the view, its reach +-60 deg.
+static void test_a_stroke_fades_out_where_the_surface_turns_away(void)
+{
+    enum { ARC = 201, ROWS = 21 };  // -100..100 deg, y -0.05..0.05
+    const float R = 0.1f, deg = 3.14159265f / 180.0f;
+    rs_splat *s = calloc(ARC * ROWS, sizeof *s);
+    REQUIRE(s);
+    for (uint32_t y = 0; y < ROWS; y++)
+        for (uint32_t a = 0; a < ARC; a++) {
+            float phi = ((float)a - 100.0f) * deg, n[3] = {sinf(phi), 0.0f, cosf(phi)};
+            s[y * ARC + a] = (rs_splat){{R * n[0], -0.05f + 0.005f * (float)y, R * n[2]}, {n[0], n[1], n[2]}, 0.005f,
+                                        {196, 150, 128}, 1};
+        }
+    rs_splat_cloud *c = make_cloud(s, ARC * ROWS, frame(1.0f));
+    free(s);
+    rs_makeup *mk = layer(c, NULL);
+    REQUIRE(mk);
+    rs_makeup_stamp_desc d = stamp_at(R * sinf(75.0f * deg), 0.0f, 0.2f, "blush");
+    d.pos[2] = R * cosf(75.0f * deg);
+    d.opacity = 1.0f;
+    REQUIRE(stamp(mk, &d, NULL));
+    const rs_makeup_gpu *rec = rs_makeup_records(mk) + (ROWS / 2) * ARC;  // the row through the stamp
+    int peak = 0, jump = 0, jump_at = 0, beyond = 0;
+    for (int a = 0; a < ARC; a++) peak = RS_MAX(peak, rec[a].colour_i);
+    for (int a = 1; a < ARC; a++) {
+        int step = abs((int)rec[a].colour_i - (int)rec[a - 1].colour_i);
+        if (step > jump) jump = step, jump_at = a - 100;
+    }
+    for (int a = 190; a < ARC; a++) beyond += rec[a].colour_i > 0;  // 90 deg and on: facing away
+    int grazing = rec[100 + 84].colour_i;                            // N.V 0.10
+    printf("# stroke towards the side: peak %d/255, largest step between splats a degree apart %d (at %d deg), "
+           "%d/255 at N.V 0.10, %d splats painted facing away\n", peak, jump, jump_at, grazing, beyond);
+    RS_CHECK(peak > 100, "the stamp painted %d/255 at most", peak);
+    RS_CHECK(jump <= peak / 8, "the blush steps by %d/255 between neighbouring splats at %d deg (peak %d): an edge",
+             jump, jump_at, peak);
+    RS_CHECK(grazing > 0 && grazing < peak / 2, "at N.V 0.10 the blush is %d/255 (want a fading share of %d)",
+             grazing, peak);
+    RS_CHECK(beyond == 0, "%d splats facing away from the brush were painted", beyond);
+    rs_makeup_destroy(mk);
+    rs_splat_destroy(c);
+}
+
 static void test_detail_keeps_skin_texture_and_range_under_foundation(void)
 {
     rs_splat_cloud *c = plane(101, 1.0f);
@@ -1029,6 +1074,7 @@ int main(int argc, char **argv)
     RS_RUN(test_cancel_and_clear_restore_and_undo);
     RS_RUN(test_mirror_stamp_paints_symmetrically);
     RS_RUN(test_facing_test_keeps_stamp_off_the_far_side);
+    RS_RUN(test_a_stroke_fades_out_where_the_surface_turns_away);
     RS_RUN(test_detail_keeps_skin_texture_and_range_under_foundation);
     RS_RUN(test_gather_on_600k_splats_touches_only_nearby_cells);
     RS_RUN(test_nearest_respects_tolerance);

@@ -280,6 +280,15 @@ float rs_makeup_tip_hardness(const rs_cosmetic *c)
     }
 }
 
+float rs_makeup_facing(const float n[3], const float v[3], float vl, bool whole)
+{
+    float d = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
+    if (!(d > 0.0f)) return 0.0f;
+    if (whole || d >= RS_MAKEUP_FACING_FULL * vl) return 1.0f;
+    float t = d / (RS_MAKEUP_FACING_FULL * vl);
+    return t * t * (3.0f - 2.0f * t);
+}
+
 float rs_makeup_touch_weight(uint32_t touches) { return 1.0f - expf(-(float)touches / RS_MAKEUP_TOUCH_K); }
 
 float rs_makeup_intensity(float i_g, float i_m, float i_f)
@@ -1250,8 +1259,7 @@ static bool log_has_fine(const rs_makeup *mk)
 typedef struct stamp_ctx {
     rs_makeup *mk;
     const float *p, *view;
-    bool facing;
-    float facing_min;  // RS_MAKEUP_FACING_MIN * |view|: no normalising, so replays see the same bits
+    float view_len;  // 0: no facing test
     float r2, inv_r2, amount;
     const prepared *cos;  // NULL = eraser
     const uint8_t *mask;  // region mask weights (q/255), NULL = none
@@ -1266,11 +1274,9 @@ static void stamp_splat(stamp_ctx *x, uint32_t i)
     float dx = q[0] - x->p[0], dy = q[1] - x->p[1], dz = q[2] - x->p[2];
     float d2 = dx * dx + dy * dy + dz * dz;
     if (!(d2 < x->r2)) return;
-    if (x->facing) {
-        const float *nrm = mk->cloud->normal[i];
-        if (!(nrm[0] * x->view[0] + nrm[1] * x->view[1] + nrm[2] * x->view[2] > x->facing_min)) return;
-    }
-    float ig = falloff_t(d2 * x->inv_r2, x->cos ? x->cos->hard : 0.0f);
+    float facing = x->view_len > 0.0f ? rs_makeup_facing(mk->cloud->normal[i], x->view, x->view_len, !x->cos) : 1.0f;
+    if (!(facing > 0.0f)) return;
+    float ig = falloff_t(d2 * x->inv_r2, x->cos ? x->cos->hard : 0.0f) * facing;
     if (x->mask) ig *= x->mask[i] * (1.0f / 255.0f);  // outside the product's region: 0, soft at its edge
     if (!(ig > 0.0f)) return;
     x->info->touched++;
@@ -1343,7 +1349,7 @@ static void apply_stamp(rs_makeup *mk, const rs_makeup_applied *s, const rs_cosm
     }
     const float *v = s->view_dir;
     float vlen = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-    stamp_ctx x = {mk, s->pos, v, vlen > 0.0f, RS_MAKEUP_FACING_MIN * vlen, s->radius * s->radius,
+    stamp_ctx x = {mk, s->pos, v, vlen, s->radius * s->radius,
                    1.0f / (s->radius * s->radius), s->amount, cos, mask, info};
     for_cells(mk, s->pos, s->radius, stamp_cell, &x, &info->cells);
     mk->stamps[mk->stamp_count++] = *s;

@@ -62,7 +62,8 @@ typedef enum rs_makeup_pressure {
     RS_MAKEUP_PRESSURE_COUNT,
 } rs_makeup_pressure;
 
-#define RS_MAKEUP_FACING_MIN 0.2f   // facing test: dot(normal, view_dir) must exceed this
+#define RS_MAKEUP_FACING_MIN 0.2f   // smudge's sampling: dot(normal, view_dir) must exceed this
+#define RS_MAKEUP_FACING_FULL 0.3f  // a brush deposits fully from this dot(normal, view_dir) on (rs_makeup_facing)
 #define RS_MAKEUP_TOUCH_K 1.0f      // I_F = 1 - exp(-touches / K), touches = strokes that reached the splat
 #define RS_MAKEUP_SIGMA_REL 0.5f    // I_G Gaussian sigma = 0.5 * brush radius (shifted to reach 0 at the rim)
 #define RS_MAKEUP_MASK_EDGE_MM 1.5f // region masks fade in over this distance inside the region's border
@@ -236,6 +237,12 @@ float rs_makeup_falloff(float dist, float radius);
 float rs_makeup_tip_hardness(const rs_cosmetic *c);
 // I_G of a tip of that hardness (rs_makeup_falloff when hardness is 0).
 float rs_makeup_tip_falloff(float dist, float radius, float hardness);
+// How much of a stamp reaches a surface of unit normal n from view_dir v (|v| = vl > 0, not normalised:
+// replays compute the same bits): 0 facing away; an eraser, or a product kept to a region by its field
+// (`whole`), all of it; a brush fades out over the last RS_MAKEUP_FACING_FULL of N.V before edge-on, as
+// bristles pushed along v glance off a surface turning away (smoothstep), so a stroke leaves no edge
+// where the surface turns from the view (makeup_fine.glsl rs_fine_facing mirrors it).
+float rs_makeup_facing(const float n[3], const float v[3], float vl, bool whole);
 // I_F from the touch count.
 float rs_makeup_touch_weight(uint32_t touches);
 // Eq. (3) with the brush footprint over every term: I = I_G * (0.3 + 0.3 I_M + 0.3 I_F); equals the

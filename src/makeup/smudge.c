@@ -146,14 +146,15 @@ static layer fine_at(const fine_set *f, const float pm[3], const float nm[3])
         }
         const float *v = s->view_dir;
         float vl = sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-        // As makeup_fine.glsl: a product kept to a region needs the surface to face the view at all.
-        float facing_min = s->region ? 0.0f : RS_MAKEUP_FACING_MIN;
-        if (vl > 0.0f && nm[0] * v[0] + nm[1] * v[1] + nm[2] * v[2] <= facing_min * vl) continue;
         eraser = s->eraser != 0;
         product = !eraser && s->cosmetic < f->product_count ? &f->products[s->cosmetic] : NULL;
         if (!eraser && !product) continue;
+        // As makeup_fine.glsl: a product kept to a region needs the surface to face the view at all.
+        float facing = vl > 0.0f ? rs_makeup_facing(nm, v, vl, eraser || s->region) : 1.0f;
+        if (!(facing > 0.0f)) continue;
         float dx = pm[0] - s->pos[0], dy = pm[1] - s->pos[1], dz = pm[2] - s->pos[2];
-        float ig = rs_makeup_tip_falloff(sqrtf(dx * dx + dy * dy + dz * dz), s->radius, eraser ? 0.0f : product->hard);
+        float ig = rs_makeup_tip_falloff(sqrtf(dx * dx + dy * dy + dz * dz), s->radius, eraser ? 0.0f : product->hard)
+                   * facing;
         if (s->region && ig > 0.0f)  // kept to a region: fills its mask within the brush's reach (the shader)
             ig = RS_MIN(1.0f, 4.0f * ig) * rs_makeup_field_weight(s->region < RS_COSMETIC_REGION_COUNT ? f->fields[s->region] : NULL, pm);
         if (!(ig > 0.0f)) continue;
