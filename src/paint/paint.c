@@ -7,6 +7,9 @@
 
 #define DEFAULT_SPACING_REL 0.15f       // stamp spacing = 15 % of the brush radius (Blender: 10 % of diameter)
 #define REPLAY_POINTER_ID (-0x7fff0000)  // an id no device hands out
+#define BRIDGE_MIN_REL 0.5f   // consecutive stamps further apart than this many brush radii get stamps between
+#define BRIDGE_MAX_REL 4.0f   // ... unless further than this (a jump across a fold or off an edge: not bridged)
+#define BRIDGE_MAX 16         // at most this many stamps between two
 
 struct rs_paint {
     rs_makeup *mk;
@@ -18,6 +21,8 @@ struct rs_paint {
     rs_strokes *rec;
     rs_strokes_view rec_view;
     rs_smudge smudge;             // the load of a smudge or blend stroke in progress
+    float last[3];                // the stroke's last paint stamp (has_last): where bridge() starts
+    bool has_last;
     bool rec_open;
     int32_t rec_pointer;
     double rec_t0;
@@ -108,18 +113,32 @@ static bool pick(const rs_paint *p, float x, float y, uint32_t *idx, float hit[3
     return p->picker.pick(p->picker.user, x, y, idx, hit) && *idx < rs_makeup_count(p->mk);
 }
 
+// Stamps to put between two consecutive ones a and b, radius r: stamps are spaced on screen and placed at
+// the surface point of the pixel under the pointer, so where the surface turns from the view neighbouring
+// pixels' points lie millimetres apart and a narrow brush fell apart into dots there. A gap of more than
+// half a radius is filled at the stroke's spacing (a jump of more than 4 radii, across a fold or off an
+// edge, is left: the stroke left that surface).
+static uint32_t bridge(const rs_paint *p, const float a[3], const float b[3], float r)
+{
+    float dx = b[0] - a[0], dy = b[1] - a[1], dz = b[2] - a[2], d = sqrtf(dx * dx + dy * dy + dz * dz);
+    if (!(d > BRIDGE_MIN_REL * r) || d > BRIDGE_MAX_REL * r) return 0;
+    return (uint32_t)RS_MIN(ceilf(d / (p->spacing_rel * r)) - 1.0f, (float)BRIDGE_MAX);
+}
+
 static rs_result stamp_at(rs_paint *p, const rs_input_stamp *s, rs_paint_result *res, rs_error *err)
 {
     uint32_t idx;
     float pos[3];
     if (!pick(p, s->x_px, s->y_px, &idx, pos)) {
         res->misses++;  // background: stamp nothing
+        p->has_last = false;
         return RS_OK;
     }
     const rs_splat_cloud *cloud = rs_makeup_cloud(p->mk);
     const rs_paint_brush *b = &p->stroke_brush;
     rs_makeup_stamp_info info;
     if (b->tool != RS_TOOL_PAINT) {
+        p->has_last = false;
         rs_smudge_stamp_desc sd = {.pos = {pos[0], pos[1], pos[2]},
                                    .radius = rs_makeup_brush_radius(&cloud->hdr, b->size_rel),
                                    .strength = b->opacity,
@@ -145,11 +164,18 @@ static rs_result stamp_at(rs_paint *p, const rs_input_stamp *s, rs_paint_result 
         .mirror = b->mirror,
         .region_mask = !b->any_region,
     };
-    if (p->picker.view_dir) p->picker.view_dir(p->picker.user, pos, d.view_dir);
-    rs_result r = rs_makeup_stamp(p->mk, &d, &info, err);
-    if (r != RS_OK) return r;
-    merge(&res->dirty, info.dirty);
-    res->stamps++;
+    uint32_t n = p->has_last ? bridge(p, p->last, pos, d.radius) : 0;
+    for (uint32_t k = 1; k <= n + 1; k++) {
+        float t = (float)k / (float)(n + 1);
+        for (int a = 0; a < 3; a++) d.pos[a] = k > n ? pos[a] : p->last[a] + (pos[a] - p->last[a]) * t;
+        if (p->picker.view_dir) p->picker.view_dir(p->picker.user, d.pos, d.view_dir);
+        rs_result r = rs_makeup_stamp(p->mk, &d, &info, err);
+        if (r != RS_OK) return r;
+        merge(&res->dirty, info.dirty);
+        res->stamps++;
+    }
+    memcpy(p->last, pos, sizeof p->last);
+    p->has_last = true;
     update_spacing(p, pos);
     return RS_OK;
 }
@@ -184,6 +210,7 @@ rs_result rs_paint_feed(rs_paint *p, const rs_input_event *ev, rs_paint_result *
     res->stroke_begin = out.stroke_begin, res->stroke_end = out.stroke_end, res->stroke_cancel = out.stroke_cancel;
 
     if (out.stroke_begin) {
+        p->has_last = false;
         rs_makeup_begin_stroke(p->mk);
         rs_smudge_begin(&p->smudge, p->stroke_brush.tool);
         if (p->rec) {
@@ -235,7 +262,9 @@ static bool replay_within_bound(const rs_paint *p, const rs_strokes_sample *sm, 
                                 double q, uint32_t *stamps)
 {
     rs_input in = p->input;
-    float size_rel = resolve_brush(&p->brush).size_rel;
+    rs_paint_brush b = resolve_brush(&p->brush);
+    float size_rel = b.size_rel, radius = rs_makeup_brush_radius(&rs_makeup_cloud(p->mk)->hdr, size_rel), last[3];
+    bool has_last = false;
     rs_input_output out;
     *stamps = 0;
     for (uint32_t k = 0; k < n + (n == 1); k++) {
@@ -246,8 +275,14 @@ static bool replay_within_bound(const rs_paint *p, const rs_strokes_sample *sm, 
             set_spacing(p, &in, size_rel, hit);
         rs_input_feed(&in, &ev, &out);
         for (uint32_t i = 0; i < out.stamp_count; i++) {
-            if (!pick(p, out.stamps[i].x_px, out.stamps[i].y_px, &idx, hit)) continue;
-            ++*stamps;
+            if (!pick(p, out.stamps[i].x_px, out.stamps[i].y_px, &idx, hit)) {
+                has_last = false;
+                continue;
+            }
+            // As stamp_at: with the stamps it bridges to the last one.
+            *stamps += 1 + (has_last && b.tool == RS_TOOL_PAINT ? bridge(p, last, hit, radius) : 0);
+            memcpy(last, hit, sizeof last);
+            has_last = true;
             set_spacing(p, &in, size_rel, hit);
         }
         if (*stamps * q * q > RS_PAINT_MAX_REPLAY_COVER) return false;
