@@ -62,7 +62,6 @@ typedef enum rs_makeup_pressure {
     RS_MAKEUP_PRESSURE_COUNT,
 } rs_makeup_pressure;
 
-#define RS_MAKEUP_FACING_MIN 0.2f   // smudge's sampling: dot(normal, view_dir) must exceed this
 #define RS_MAKEUP_FACING_FULL 0.3f  // a brush deposits fully from this dot(normal, view_dir) on (rs_makeup_facing)
 #define RS_MAKEUP_TOUCH_K 1.0f      // I_F = 1 - exp(-touches / K), touches = strokes that reached the splat
 #define RS_MAKEUP_SIGMA_REL 0.5f    // I_G Gaussian sigma = 0.5 * brush radius (shifted to reach 0 at the rim)

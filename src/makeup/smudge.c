@@ -178,8 +178,7 @@ static layer fine_at(const fine_set *f, const float pm[3], const float nm[3])
 typedef struct gather_ctx {
     const rs_makeup *mk;
     const float *view;
-    float facing_min, radius;
-    bool facing;
+    float view_len, radius;  // view_len 0: no facing test
     uint32_t seen, stride;
     const fine_set *fine;
     // sums
@@ -188,27 +187,28 @@ typedef struct gather_ctx {
     uint32_t points;
 } gather_ctx;
 
-static bool faces(const gather_ctx *x, uint32_t i)
+// How much the brush reaches splat i: what it samples is weighted as a stamp there would lay it down.
+static float facing(const gather_ctx *x, uint32_t i)
 {
-    if (!x->facing) return true;
-    const float *n = rs_makeup_cloud(x->mk)->normal[i];
-    return n[0] * x->view[0] + n[1] * x->view[1] + n[2] * x->view[2] > x->facing_min;
+    if (!(x->view_len > 0.0f)) return 1.0f;
+    return rs_makeup_facing(rs_makeup_cloud(x->mk)->normal[i], x->view, x->view_len, false);
 }
 
 static bool count_one(void *user, uint32_t i, float d2)
 {
     (void)d2;
     gather_ctx *x = user;
-    x->seen += faces(x, i);
+    x->seen += facing(x, i) > 0.0f;
     return true;
 }
 
 static bool sample_one(void *user, uint32_t i, float d2)
 {
     gather_ctx *x = user;
-    if (!faces(x, i)) return true;
+    float f = facing(x, i);
+    if (!(f > 0.0f)) return true;
     if (x->seen++ % x->stride != 0) return true;
-    float w = rs_makeup_falloff(sqrtf(d2), x->radius);
+    float w = rs_makeup_falloff(sqrtf(d2), x->radius) * f;
     if (!(w > 0.0f)) return true;
     const rs_splat_cloud *cloud = rs_makeup_cloud(x->mk);
     layer l = record_layer(&rs_makeup_records(x->mk)[i]);
@@ -245,8 +245,7 @@ rs_result rs_smudge_sample_at(const rs_makeup *mk, const float pos[3], const flo
         return r;
     }
     float vl = sqrtf(view_dir[0] * view_dir[0] + view_dir[1] * view_dir[1] + view_dir[2] * view_dir[2]);
-    gather_ctx x = {.mk = mk, .view = view_dir, .facing_min = RS_MAKEUP_FACING_MIN * vl, .radius = radius,
-                    .facing = vl > 0.0f, .fine = &fine, .level_min = 1.0f};
+    gather_ctx x = {.mk = mk, .view = view_dir, .view_len = vl, .radius = radius, .fine = &fine, .level_min = 1.0f};
     rs_makeup_for_each_near(mk, pos, radius, count_one, &x);
     // Spread the evaluated points over the footprint: every stride-th splat in grid order.
     x.stride = x.seen > RS_SMUDGE_SAMPLES_MAX ? (x.seen + RS_SMUDGE_SAMPLES_MAX - 1) / RS_SMUDGE_SAMPLES_MAX : 1;

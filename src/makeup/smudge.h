@@ -78,7 +78,8 @@ void rs_smudge_begin(rs_smudge *s, rs_paint_tool tool);
 // updates the load. ROUGE_ERR_ARG-style failures come from rs_makeup_stamp (not finite, bad radius).
 rs_result rs_smudge_stamp(rs_smudge *s, rs_makeup *mk, const rs_smudge_stamp_desc *d, rs_makeup_stamp_info *info,
                           rs_error *err);
-// The makeup under a footprint of `radius` at pos (splats facing view_dir; all zero: no facing test).
+// The makeup under a footprint of `radius` at pos, each splat weighted as a brush from view_dir would reach it
+// (rs_makeup_facing; view_dir all zero: no facing test).
 rs_result rs_smudge_sample_at(const rs_makeup *mk, const float pos[3], const float view_dir[3], float radius,
                               rs_smudge_sample *out, rs_error *err);
 
