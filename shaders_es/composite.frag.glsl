@@ -244,14 +244,6 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
     return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
 }
 
-// The reflections' texel of sample i around pixel px: 0..7 on a circle of mm pixels, 8 the pixel itself.
-ivec2 reflection_sample(ivec2 px, int i, float mm)
-{
-    float a = float(i) * 0.78539816;
-    vec2 off = i == 8 ? vec2(0.0) : mm * vec2(cos(a), sin(a));
-    return clamp(px + ivec2(round(off)), ivec2(0), ivec2(u_viewport) - 1) / 2;
-}
-
 // Whether the face itself blocks the mirror direction R (reflect.frag.glsl's march, at half size),
 // averaged over the pixel and 8 around it at 1 mm (at least 4 px) that lie on its surface (within 1 mm of
 // its tangent plane and 5 mm of it) and mirror about its way: one pixel's march ends in a sharp edge where
@@ -265,8 +257,16 @@ void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool 
     float mm = clamp(u_proj[1][1] * 0.5 * u_viewport.y / -p.z * u_contour_reach / 20.0, 4.0, 16.0);
     vec2 half_size = vec2(textureSize(u_reflect, 0));
     float w_sum = 0.0, o_sum = 0.0, w_left = 0.0;
-    for (int i = 8; i >= 0; i--) {  // the pixel's own sample first
-        ivec2 t = reflection_sample(px, i, mm);
+    // The samples' rays: the unprojected point at the near plane is affine in the pixel's NDC (h0 + hx x
+    // + hy y; its w cancels), and the 8 around turn by 45 degrees each. The sines and cosines and a matrix
+    // per sample were half of this average's cost on llvmpipe.
+    vec3 h0 = (u_inv_proj * vec4(0.0, 0.0, -1.0, 1.0)).xyz, hx = u_inv_proj[0].xyz, hy = u_inv_proj[1].xyz;
+    const float c45 = 0.70710678;
+    vec2 dir = vec2(c45, -c45) * mm;  // sample 7's offset, at 315 degrees
+    ivec2 hi = ivec2(u_viewport) - 1;
+    for (int i = 8; i >= 0; i--) {  // the pixel's own sample first, then 7 down to 0
+        ivec2 t = clamp(px + (i == 8 ? ivec2(0) : ivec2(round(dir))), ivec2(0), hi) / 2;
+        if (i < 8) dir = c45 * vec2(dir.x + dir.y, dir.y - dir.x);  // 45 degrees back
         uvec4 r = texelFetch(u_reflect, t, 0);
         if (r.x == 0u) continue;  // no surface there
         float o = unpackHalf2x16(r.z).y;
@@ -274,8 +274,8 @@ void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool 
         o -= l ? 2.0 : 0.0;
         // Its point: on the ray through the full-size pixel at its centre, at its depth.
         vec2 ndc = (floor((vec2(t) + 0.5) / half_size * u_viewport) + 0.5) / u_viewport * 2.0 - 1.0;
-        vec4 h = u_inv_proj * vec4(ndc, -1.0, 1.0);
-        vec3 s = h.xyz / h.w * (uintBitsToFloat(r.x) / (h.z / h.w)), d = s - p;
+        vec3 h = h0 + hx * ndc.x + hy * ndc.y;
+        vec3 s = h * (uintBitsToFloat(r.x) / h.z), d = s - p;
         if (abs(dot(d, N)) > 0.05 * u_contour_reach || dot(d, d) > 0.0625 * u_contour_reach * u_contour_reach)
             continue;
         // Its mirror direction within the lobe's width of this one's (at a rim it turns fast).

@@ -43,23 +43,35 @@ float rs_beckmann_lambda(float c, float m)
     return (1.0 - 1.259 * a + 0.396 * a * a) / (3.535 * a + 2.181 * a * a);
 }
 
-float rs_ksk_lobe(vec3 N, vec3 L, vec3 V, float m, float f0)
+// The lobe towards light L from the factors that depend on the view alone (rs_ksk_view): where one view
+// meets many lights (the environment's grid of taps, a lamp's strips) they are worked out once.
+float rs_ksk_lobe_seen(vec3 N, vec3 L, vec3 V, float mm, float f0, vec2 view)
 {
     float ndotl = dot(N, L);
-    // At the outline the interpolated normal can turn a little away from the eye; the surface the camera
-    // sees there is edge-on, where G / N.V tends to a finite limit (about 3.5 / m): N.V is held above 1e-3.
-    float ndotv = max(dot(N, V), 1e-3);
     vec3 h = L + V;
     float hh = dot(h, h);
     if (ndotl <= 0.0 || hh < 1e-6) return 0.0;
     vec3 H = h * inversesqrt(hh);
     float ndoth = dot(N, H);
     if (ndoth <= 0.0) return 0.0;
-    float mm = max(m, 0.02);
     float ph = rs_beckmann(ndoth, mm);
     float f = rs_schlick(clamp(dot(V, H), 0.0, 1.0), f0);
-    float g = 1.0 / (1.0 + rs_beckmann_lambda(ndotv, mm) + rs_beckmann_lambda(ndotl, mm));
-    return max(ph * f * g / (4.0 * ndotv), 0.0);
+    return max(ph * f / (1.0 + view.x + rs_beckmann_lambda(ndotl, mm)) * view.y, 0.0);
+}
+
+// The view's shadowing (Smith's lambda for N.V) and 1 / (4 N.V), for roughness mm = max(m, 0.02). At the
+// outline the interpolated normal can turn a little away from the eye; the surface the camera sees there is
+// edge-on, where G / N.V tends to a finite limit (about 3.5 / m): N.V is held above 1e-3.
+vec2 rs_ksk_view(vec3 N, vec3 V, float mm)
+{
+    float ndotv = max(dot(N, V), 1e-3);
+    return vec2(rs_beckmann_lambda(ndotv, mm), 0.25 / ndotv);
+}
+
+float rs_ksk_lobe(vec3 N, vec3 L, vec3 V, float m, float f0)
+{
+    float mm = max(m, 0.02);
+    return rs_ksk_lobe_seen(N, L, V, mm, f0, rs_ksk_view(N, V, mm));
 }
 
 float rs_ksk_specular(vec3 N, vec3 L, vec3 V, float m, float rho_s)

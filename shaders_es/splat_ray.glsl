@@ -58,7 +58,7 @@ bool rs_visible_point_at(ivec2 px, out vec3 p)
     if (z >= 1.0) return false;
     vec2 ndc = (vec2(px) + 0.5) / vec2(textureSize(u_depth, 0)) * 2.0 - 1.0;
     vec4 h = u_inv_proj * vec4(ndc, z * 2.0 - 1.0, 1.0);
-    p = h.xyz / h.w;
+    p = h.xyz * (1.0 / h.w);
     p -= normalize(p) * rs_push_at(u_push, px, u_eps);
     return true;
 }

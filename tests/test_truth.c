@@ -502,8 +502,8 @@ static void test_view(void)
            ref->env, ref->view, r.k, r.iou, r.albedo_diff, r.delta_e);
     for (int i = 0; i < R_COUNT; i++)
         if (r.region_px[i] >= 20) printf(" %s %.3f", region_names[i], r.ratio[i]);
-    printf("; contour band rouge / path tracer %.3f +- %.3f (%d px: under the jaw %.3f, %d px; above it %.3f; along"
-           " the outline %.3f, at inner depth steps %.3f); specular areas, path tracer / rouge: forehead %.3f"
+    printf("; contour band rouge / path tracer %.4f +- %.3f (%d px: under the jaw %.4f, %d px; above it %.4f; along"
+           " the outline %.4f, at inner depth steps %.4f); specular areas, path tracer / rouge: forehead %.3f"
            " highlights %.3f; glare %.2f %% of the face\n", r.band, r.band_noise, r.band_px, r.band_low,
            r.band_low_px, r.band_high, r.band_outline, r.band_inner, r.forehead, r.highlights, r.glare);
     // The fixture is the scene rouge renders: same camera and outline, same albedo.
