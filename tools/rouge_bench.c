@@ -817,8 +817,8 @@ static void env_rows_isolated(bench *b)
         child_result c = run_child(argv, out, 600);
         FILE *f = c.ran && c.status == 0 ? fopen(out, "r") : NULL;
         if (!f) {
-            snprintf(why, sizeof why, "run %d: %s %d", k + 1, c.ran ? "exit status" : "timed out or did not start",
-                     c.ran ? c.status : c.status);
+            if (c.ran) snprintf(why, sizeof why, "run %d: exit status %d", k + 1, c.status);
+            else snprintf(why, sizeof why, "run %d: %s", k + 1, c.status == 124 ? "timed out" : "did not start");
             continue;
         }
         char line[1024], note[320] = "";
