@@ -282,6 +282,7 @@ float rs_makeup_tip_hardness(const rs_cosmetic *c)
 
 float rs_makeup_facing(const float n[3], const float v[3], float vl, bool whole)
 {
+    if (!(vl > 0.0f)) return 1.0f;  // no view: no facing test
     float d = n[0] * v[0] + n[1] * v[1] + n[2] * v[2];
     if (!(d > 0.0f)) return 0.0f;
     if (whole || d >= RS_MAKEUP_FACING_FULL * vl) return 1.0f;
@@ -1274,7 +1275,7 @@ static void stamp_splat(stamp_ctx *x, uint32_t i)
     float dx = q[0] - x->p[0], dy = q[1] - x->p[1], dz = q[2] - x->p[2];
     float d2 = dx * dx + dy * dy + dz * dz;
     if (!(d2 < x->r2)) return;
-    float facing = x->view_len > 0.0f ? rs_makeup_facing(mk->cloud->normal[i], x->view, x->view_len, !x->cos) : 1.0f;
+    float facing = rs_makeup_facing(mk->cloud->normal[i], x->view, x->view_len, !x->cos);
     if (!(facing > 0.0f)) return;
     float ig = falloff_t(d2 * x->inv_r2, x->cos ? x->cos->hard : 0.0f) * facing;
     if (x->mask) ig *= x->mask[i] * (1.0f / 255.0f);  // outside the product's region: 0, soft at its edge

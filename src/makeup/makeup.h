@@ -236,8 +236,8 @@ float rs_makeup_falloff(float dist, float radius);
 float rs_makeup_tip_hardness(const rs_cosmetic *c);
 // I_G of a tip of that hardness (rs_makeup_falloff when hardness is 0).
 float rs_makeup_tip_falloff(float dist, float radius, float hardness);
-// How much of a stamp reaches a surface of unit normal n from view_dir v (|v| = vl > 0, not normalised:
-// replays compute the same bits): 0 facing away; an eraser, or a product kept to a region by its field
+// How much of a stamp reaches a surface of unit normal n from view_dir v (|v| = vl, not normalised:
+// replays compute the same bits; vl 0: no facing test, 1): 0 facing away; an eraser, or a product kept to a region by its field
 // (`whole`), all of it; a brush fades out over the last RS_MAKEUP_FACING_FULL of N.V before edge-on, as
 // bristles pushed along v glance off a surface turning away (smoothstep), so a stroke leaves no edge
 // where the surface turns from the view (makeup_fine.glsl rs_fine_facing mirrors it).

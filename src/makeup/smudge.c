@@ -150,7 +150,7 @@ static layer fine_at(const fine_set *f, const float pm[3], const float nm[3])
         product = !eraser && s->cosmetic < f->product_count ? &f->products[s->cosmetic] : NULL;
         if (!eraser && !product) continue;
         // As makeup_fine.glsl: a product kept to a region needs the surface to face the view at all.
-        float facing = vl > 0.0f ? rs_makeup_facing(nm, v, vl, eraser || s->region) : 1.0f;
+        float facing = rs_makeup_facing(nm, v, vl, eraser || s->region);
         if (!(facing > 0.0f)) continue;
         float dx = pm[0] - s->pos[0], dy = pm[1] - s->pos[1], dz = pm[2] - s->pos[2];
         float ig = rs_makeup_tip_falloff(sqrtf(dx * dx + dy * dy + dz * dz), s->radius, eraser ? 0.0f : product->hard)
@@ -190,7 +190,6 @@ typedef struct gather_ctx {
 // How much the brush reaches splat i: what it samples is weighted as a stamp there would lay it down.
 static float facing(const gather_ctx *x, uint32_t i)
 {
-    if (!(x->view_len > 0.0f)) return 1.0f;
     return rs_makeup_facing(rs_makeup_cloud(x->mk)->normal[i], x->view, x->view_len, false);
 }
 
