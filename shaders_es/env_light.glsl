@@ -15,6 +15,8 @@ uniform float u_env_m[8];
 uniform int u_env_levels;
 uniform float u_env_scale;          // exposure normalisation of the map (the SH carry theirs)
 uniform highp sampler2D u_spec_lut; // (N.V, m) -> (A, B): the lobe's directional albedo is F0 A + B
+uniform float u_env_one_lookup;     // rs_env_specular: one lookup from this N.V on, the grid below it
+uniform float u_env_across;         // 1: the grid has taps across the plane of incidence; 0: along it only
 #ifndef RS_HAS_BENT_DECLARED  // splat_decode.glsl declares it too
 #define RS_HAS_BENT_DECLARED
 uniform float u_has_bent;           // 1: the splats carry bent normals (RS_SPLAT_FLAG_BENT): rs_env_sky's cones
@@ -134,6 +136,9 @@ float rs_env_lobe_albedo(float ndotv, float m, float f0)
 // tracer the same or lower). From 0.45 it would save llvmpipe another ~3 ms a 512^2 frame, but the rim
 // pixels between lose the horizon's cut, whose taps above it are the brighter sky: the contour band
 // against the path tracer fell 0.0005 (studio 3/4 to 0.9997, under issue 22's goal of 1).
+// The mobile pipeline (render_kit.h, docs/mobile.md) saves both ways: one lookup from N.V 0.55 and the
+// 5 taps along the plane of incidence only (across, the taps' own spread, 0.75 of the lobe's, stands for
+// the lobe's): ~3.5 ms of a 512^2 frame on llvmpipe; its frames 52-67 dB from what it drew before.
 vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
 {
     // All in the environment's frame (a rotation of view space: the lobe's dot products are kept).
@@ -142,13 +147,15 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     vec3 R = reflect(-V, N);
     float across = clamp(ndotv, 0.0, 1.0);    // the lobe's width across the plane of incidence, relative
     // Facing the eye the lobe is nearly round and far above the horizon, and one lookup of its whole
-    // spread (along and across averaged) does; from N.V 0.45 to 0.6 the grid's spread eases into that one
-    // lookup's, so its taps close in on R and no seam shows where their number drops.
-    float s1 = sqrt(0.5 + 0.5 * across * across), e = smoothstep(0.45, 0.6, across);
+    // spread (along and across averaged) does (from u_env_one_lookup); over the 0.15 of N.V below that
+    // the grid's spread eases into that one lookup's, so its taps close in on R and no seam shows where
+    // their number drops.
+    float s1 = sqrt(0.5 + 0.5 * across * across);
+    float e = smoothstep(u_env_one_lookup - 0.15, u_env_one_lookup, across);
     float s = mix(max(0.75 * across, 0.2), s1, e);  // the taps' own spread, relative to the lobe's
     float lod = rs_env_lod(s * m);
     // One lookup: the tap at R, whose weight is the lobe over itself (1).
-    if (across >= 0.6) return rs_env_radiance(R, lod) * rs_env_lobe_albedo(ndotv, m, f0);
+    if (across >= u_env_one_lookup) return rs_env_radiance(R, lod) * rs_env_lobe_albedo(ndotv, m, f0);
     // t1: in the plane of incidence, from R towards N; t2 across it.
     vec3 t1 = N - R * dot(N, R);
     float l1 = dot(t1, t1);
@@ -163,7 +170,7 @@ vec3 rs_env_specular(vec3 N_view, vec3 V_view, float m, float f0)
     float g1 = d1 * d1 / (2.0 * sigma * sigma * va), g2 = d2 * d2 / (2.0 * sigma * sigma * max(vc, 1e-4));
     // Taps at a spacing of 0 fall on the centre's direction and leave the weighted mean as it is: a row or
     // column of them is skipped (at grazing, N.V <= 0.2, the grid has no width across).
-    int na = d1 > 0.0 ? 2 : 0, nc = d2 > 0.0 ? 1 : 0;
+    int na = d1 > 0.0 ? 2 : 0, nc = d2 > 0.0 && u_env_across > 0.5 ? 1 : 0;
     // The lobe's factors that depend on the view alone, once for all the taps, and 1 / the lobe at R.
     float mm = max(m, 0.02);
     vec2 view = rs_ksk_view(N, V, mm);

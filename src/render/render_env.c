@@ -391,6 +391,9 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
     glUniform1fv(rs_uloc(prog, "u_env_m"), RS_ENV_MAX_LEVELS, r->env.level_m);
     glUniform1i(rs_uloc(prog, "u_env_levels"), r->env.levels);
     glUniform1f(rs_uloc(prog, "u_env_scale"), r->env.scale * e);
+    float one_lookup = f->mobile ? RS_ENV_ONE_LOOKUP_MOBILE : RS_ENV_ONE_LOOKUP_REFERENCE;
+    glUniform1f(rs_uloc(prog, "u_env_one_lookup"), one_lookup);
+    glUniform1f(rs_uloc(prog, "u_env_across"), f->mobile ? 0.0f : 1.0f);
     // What the skin around a hollow is lit by, on average (bounce.glsl): the face's own front surface
     // (its forward turned into the environment's frame with the environment), SH and light together.
     float a = f->view.env_rotate_deg * 0.017453293f;

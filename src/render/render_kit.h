@@ -153,6 +153,11 @@ typedef struct rs_diffusion_level {
 // reference's rule) blurs the decimated image and grows its silhouette: 34.7 instead of 41.8 dB
 // against the reference at 512x512 with the 145k prefix.
 #define RS_MOBILE_COVER 0.55f
+// The environment's specular (env_light.glsl rs_env_specular): one lookup of the prefiltered map from this
+// N.V on, a grid of taps below it; the mobile pipeline's grid has no taps across the plane of incidence.
+// Mobile: ~3.5 ms less of a 512^2 frame on llvmpipe; 0.0-0.2 dB further from the reference (docs/mobile.md).
+#define RS_ENV_ONE_LOOKUP_REFERENCE 0.6f
+#define RS_ENV_ONE_LOOKUP_MOBILE 0.55f
 // The key's map: at most this size, and no larger than the output needs (render_shadow.c map_size).
 #define RS_SHADOW_SIZE_REFERENCE 4096
 #define RS_SHADOW_SIZE_MOBILE 2048
