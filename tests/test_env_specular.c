@@ -257,8 +257,8 @@ static void test_environment_specular_matches_the_lobe_over_the_capture(void)
             RS_CHECK(acos(fmin(dot3(light, env->light_dir), 1.0)) < 0.5 * PI / 180, "%s: the capture's light is "
                      "%.2f deg from the .rse's: not the same turn", envs[k].name,
                      acos(fmin(dot3(light, env->light_dir), 1.0)) * 180 / PI) &&
-            RS_CHECK(rs_render_set_env(r, env, &err) == RS_OK, "%s", err.msg) && render_specular(r, RS_PIPELINE_REFERENCE, lum) &&
-            render_specular(r, RS_PIPELINE_MOBILE, lum_mobile)) {
+            RS_CHECK(rs_render_set_env(r, env, &err) == RS_OK, "%s", err.msg) &&
+            render_specular(r, RS_PIPELINE_REFERENCE, lum) && render_specular(r, RS_PIPELINE_MOBILE, lum_mobile)) {
             rs_view v = rs_view_defaults();
             v.width = v.height = SIZE;
             float vm[16], pm[16];
@@ -280,7 +280,7 @@ static void test_environment_specular_matches_the_lobe_over_the_capture(void)
                         for (int dy = -2; dy <= 2 && inside; dy++)
                             for (int dx = -2; dx <= 2 && inside; dx++)
                                 inside = pixel_geometry(vm, pm, x + dx, y + dy, N, V);
-                        // Every 7th candidate: spread over the whole band's ring.
+                        // Every 3rd candidate: spread over the whole band's ring.
                         if (inside && seen++ % 3 == 0) cand[nc++] = y * SIZE + x;
                     }
                 double sr_sum = 0, sm_sum = 0, se_sum = 0, ratios[PER_BAND], key_r = 0, key_e = 0;
