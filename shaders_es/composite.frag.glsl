@@ -52,6 +52,11 @@ uniform mat4 u_inv_view;        // view -> model (flakes are fixed on the surfac
 uniform float u_flake_size;     // model units
 uniform float u_contour_reach;  // view units (20 mm): a surface this close behind a contour hides its rim
 uniform int u_outline_coverage; // 1: the outline's 3x3 coverage here; 0: the edges pass anti-aliases it
+uniform highp usampler3D u_body; // the cloud as a grid (render_env.c rs_render_env_body): albedo, normal
+uniform vec3 u_body_lo;          // its corner, model units
+uniform float u_body_cell;       // its cell size, model units
+uniform int u_body_n;            // its side, cells
+uniform float u_body_on;         // 1: reflections that leave the frame march it (the reference pipeline)
 
 out vec4 o_color;
 
@@ -292,6 +297,36 @@ void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool 
     open = o_sum / w_sum, blocked /= w_sum;
 }
 
+// What a reflection that runs off the frame meets (under the jaw: the neck, shoulders and chest the frame
+// cuts off, which the path tracer's skin mirrors at grazing angles, issue 22): the mirror ray from the
+// view-space point p along R is marched through the cloud's grid (cells of ~5 mm, from 2.5 cells out: past
+// the point's own surface) to the first cell of surface that faces it. False: it leaves the cloud. L: that
+// skin's radiance, its albedo lit as the splats are (SH, the key and the lamps, through their shadow maps),
+// without the skin's own occlusion or bounce.
+bool body_seen(vec3 p, vec3 R, out vec3 L)
+{
+    L = vec3(0.0);
+    vec3 o = ((u_inv_view * vec4(p, 1.0)).xyz - u_body_lo) / u_body_cell, d = mat3(u_inv_view) * R;
+    float t = 2.5;
+    for (int k = 0; k < 2 * u_body_n; k++, t += 0.7) {
+        ivec3 q = ivec3(floor(o + d * t));
+        if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(u_body_n)))) return false;
+        uint w = texelFetch(u_body, q, 0).r;
+        if (w < 0x80000000u) continue;
+        vec2 e = vec2(float((w >> 8) & 255u), float(w & 255u)) / 255.0 * 2.0 - 1.0;
+        vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+        if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+        n = normalize(n);
+        if (dot(n, d) > -0.1) continue;  // a cell seen from behind: the ray runs along or out of that surface
+        vec3 a = vec3(float((w >> 26) & 31u), float((w >> 21) & 31u), float((w >> 16) & 31u)) / 31.0;
+        vec3 nv = normalize(n * mat3(u_inv_view)), h = p + R * (t * u_body_cell);
+        L = a * (rs_env_irradiance(nv) + u_key_color * (max(dot(nv, u_key_dir), 0.0) * rs_shadow(h, nv))
+                 + rs_env_lamp_irradiance(nv, rs_env_lamp_visibility(h, nv)));
+        return true;
+    }
+    return false;
+}
+
 // How far the normal turns across this pixel (radians): the larger of its changes to the next pixel right
 // and up, where those are surface (at a rim the pixel spans a few degrees of a curved surface).
 float normal_spread(ivec2 px, vec3 N)
@@ -401,19 +436,24 @@ void main()
                 rs_tangents(N, t1, t2);
                 B = normalize(sqrt(max(1.0 - dot(bt, bt), 0.0)) * N + bt.x * t1 + bt.y * t2);
             }
-            // A reflection that runs off the frame unblocked (under the jaw: down into the neck the frame
-            // cuts off, which the path tracer's skin mirrors) is decided by what the converter saw in every
-            // direction instead: the splat's bent cone, around B with the occlusion's share (sin^2 of its
-            // half-angle = ao; soft over +-0.1 in cosine: a model of the open directions, not their outline).
-            // Outside it the lobe sees the skin around, at the radiance the bounce gives that share.
-            float open_cone = 1.0;
-            if (left && u_has_bent > 0.5) {
+            // A reflection that runs off the frame unblocked is decided in the cloud's grid (body_seen):
+            // blocked where it meets the body, which it then shows. The mobile pipeline asks the splat's
+            // bent cone instead (a march costs llvmpipe ~40 ms of a 512^2 frame): around B with the
+            // occlusion's share (sin^2 of its half-angle = ao; soft over +-0.1 in cosine: a model of the
+            // open directions, not their outline); outside it the lobe sees the skin around, at the
+            // radiance the bounce gives that share.
+            vec3 L_body = vec3(0.0);
+            float open_body = 1.0;
+            if (left && u_body_on > 0.5) {
+                open_body = body_seen(p, Rv, L_body) ? 0.0 : 1.0;
+            } else if (left && u_has_bent > 0.5) {
                 float ct = sqrt(max(1.0 - ao, 0.0));
                 // A cone of nearly the whole hemisphere (ao near 1) closes nothing: it fades in as ao
                 // goes from 1 to 0.99, not below a splat's horizon at once.
-                open_cone = 1.0 - (1.0 - smoothstep(ct - 0.1, ct + 0.1, dot(Rv, B))) * smoothstep(0.0, 0.1, ct);
+                open_body = 1.0 - (1.0 - smoothstep(ct - 0.1, ct + 0.1, dot(Rv, B))) * smoothstep(0.0, 0.1, ct);
+                L_body = rs_hidden_radiance(ao, A);
             }
-            float so = ao * open_c * open_r * open_cone;
+            float so = ao * open_c * open_r * open_body;
             E += rs_env_sky(N, B, ao) + rs_env_lamp_irradiance(N, vis);
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
@@ -434,8 +474,7 @@ void main()
             vec3 blocked = open_c * blocked_r;
             if (wc > 0.02 && hit_c.x >= 0) blocked += skin_at(hit_c) * wc;
             S += blocked * (ao * lobe);
-            float wk = open_c * open_r * (1.0 - open_cone);
-            if (wk > 0.0) S += rs_hidden_radiance(ao, A) * (wk * ao * lobe);
+            S += L_body * (open_c * open_r * (1.0 - open_body) * ao * lobe);
             if (coat > 0.0)
                 C += (rs_env_specular(N, V, mc, RS_F0_COAT) + rs_env_lamp_specular(N, V, mc, RS_F0_COAT, vis, spread)) * so;
         }

@@ -90,14 +90,20 @@ static const measured was[] = {
     // covered pixels found by rendering over black and white (before: a face pixel with background in
     // its 3x3): band daylight front 0.997 -> 0.999 (under the jaw 0.992 -> 0.997), the others within 0.002
     // (studio front 1.133 -> 1.134); IoU unchanged; glare studio front 0.21 -> 0.27 %.
-    {"studio", "front", 1.31, {1.012, 1.042, 0.972, 1.015, 1.007}, 1.134, 0.27},
-    {"studio", "threequarter", 1.62, {1.005, 1.057, 0.982, 1.023, 0.998}, 1.004, 0.08},
-    {"daylight", "front", 1.13, {0.989, 1.057, 1.030, 1.017, 1.030}, 0.999, 0.00},
-    {"daylight", "threequarter", 1.15, {0.966, 1.057, 0.992, 1.006, 1.018}, 1.002, 0.00},
-    {"office", "front", 1.45, {1.030, 1.050, 1.051, 1.009, 0.989}, 1.055, 0.00},
-    {"office", "threequarter", 1.37, {0.971, 1.053, 1.022, 0.995, 0.960}, 1.060, 0.00},
-    {"sunset", "front", 0.88, {1.000, 1.065, 1.016, 1.019, 1.027}, 1.015, 0.01},
-    {"sunset", "threequarter", 0.97, {1.003, 1.064, 0.998, 1.009, 1.019}, 1.007, 0.00},
+    // Reflections that run off the frame marched through the cloud's grid (composite.frag.glsl body_seen:
+    // the neck, shoulders and chest below the frame, lit through the shadow maps) instead of asking the
+    // splat's bent cone: dE studio 1.31 / 1.62 -> 1.28 / 1.56, daylight 1.13 / 1.16 -> 1.11 / 1.12, office
+    // 1.49 / 1.38 -> 1.44 / 1.38, sunset 0.88 / 0.97 -> 0.86 / 0.92; every band up (daylight front 0.9984
+    // -> 0.9999, under the jaw 0.9975 -> 1.0104; studio 3/4 1.0002 -> 1.0017); under the chin rouge now a
+    // little brighter than the reference (0.940-1.020); studio 3/4's ears 0.981 -> 0.963.
+    {"studio", "front", 1.28, {1.002, 1.042, 0.976, 1.016, 1.008}, 1.152, 0.25},
+    {"studio", "threequarter", 1.56, {0.996, 1.058, 0.963, 1.029, 1.005}, 1.002, 0.08},
+    {"daylight", "front", 1.11, {0.966, 1.059, 1.033, 1.019, 1.032}, 1.000, 0.00},
+    {"daylight", "threequarter", 1.12, {0.940, 1.061, 0.995, 1.009, 1.029}, 1.005, 0.00},
+    {"office", "front", 1.44, {1.020, 1.050, 1.045, 1.007, 0.990}, 1.059, 0.12},
+    {"office", "threequarter", 1.38, {0.945, 1.051, 1.020, 0.989, 0.968}, 1.068, 0.03},
+    {"sunset", "front", 0.86, {0.986, 1.066, 1.018, 1.020, 1.027}, 1.016, 0.01},
+    {"sunset", "threequarter", 0.92, {0.989, 1.067, 0.997, 1.012, 1.024}, 1.010, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
@@ -527,7 +533,7 @@ static void test_view(void)
         held &= RS_CHECK(outside(r.ratio[i]) <= outside(ref->ratio[i]) + 0.05, "%s: %.3f (was %.3f)",
                          region_names[i], r.ratio[i], ref->ratio[i]);
     }
-    if (r.band < GOAL_BAND) len += snprintf(unmet + len, sizeof unmet - len, " contour band %.3f (goal >= 1)", r.band);
+    if (r.band < GOAL_BAND) len += snprintf(unmet + len, sizeof unmet - len, " contour band %.4f (goal >= 1)", r.band);
     held &= RS_CHECK(r.band >= fmin(GOAL_BAND, ref->band - 0.03), "contour band %.3f (was %.3f)", r.band, ref->band);
     // A sheen or highlight the reference does not show (the temple's, before the lamps were reflected
     // exactly): more of the face brighter than the path tracer by dE > 10.

@@ -454,6 +454,8 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     }
     stage_mark(r, RS_STAGE_DIFFUSION, &t);
     if (res == RS_OK) res = stage_hook(r, RS_STAGE_COMPOSITE, err);
+    // The reference's reflections that leave the frame march the cloud's grid (built at the first such frame).
+    if (res == RS_OK && f.env_on && !f.mobile) res = rs_render_env_body(r, err);
     if (res == RS_OK) res = rs_render_reflections(r, &f, NULL, err);
     if (res == RS_OK) res = rs_render_composite(r, &f, err);
     if (res == RS_OK) res = rs_render_edges(r, &f, err);
@@ -490,7 +492,8 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     for (int i = 0; i < 2; i++) shadow_bytes += (size_t)r->shadow[i].size * (size_t)r->shadow[i].size * 4;
     shadow_bytes += (size_t)r->lamp_shadow.size * (size_t)r->lamp_shadow.size * 4 * RS_ENV_LAMPS;  // a layer each
     size_t pick_bytes = (size_t)r->pw * (size_t)r->ph * 8;
-    r->stats.gpu_bytes = (size_t)r->cloud->hdr.count * 40 + target_bytes(r) + shadow_bytes + pick_bytes;
+    size_t body_bytes = r->body_tex ? (size_t)RS_BODY_GRID * RS_BODY_GRID * RS_BODY_GRID * 4 : 0;
+    r->stats.gpu_bytes = (size_t)r->cloud->hdr.count * 40 + target_bytes(r) + shadow_bytes + pick_bytes + body_bytes;
     r->stats.frame_ms = (rs_time_now() - t_start) * 1000.0;
     return RS_OK;
 }

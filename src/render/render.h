@@ -28,7 +28,7 @@
 #define RS_RENDER_MAX_TARGET_BYTES (1536.0 * 1024 * 1024)
 // Texture units a frame binds, 0 .. RS_RENDER_TEXTURE_UNITS - 1 (2D, 3D and 2D-array targets), and leaves
 // empty: what an embedding that keeps its host's bindings saves.
-#define RS_RENDER_TEXTURE_UNITS 18
+#define RS_RENDER_TEXTURE_UNITS 19
 
 typedef enum rs_render_mode {
     RS_MODE_FULL = 0,   // subsurface + specular (paper Fig. 7 right)

@@ -112,12 +112,17 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     for (int i = 0; i < RS_ATTR_TARGETS; i++) rs_render_bind_texture(RS_UNIT_ATTR0 + i, r->attr_tex[i]);
     rs_render_bind_texture(RS_UNIT_DIFFUSE, f->diffuse ? r->diffuse_tex : 0);
     rs_render_bind_texture(RS_UNIT_REFLECT, f->env_on ? r->reflect_tex : 0);
+    glActiveTexture(GL_TEXTURE0 + RS_UNIT_BODY);
+    glBindTexture(GL_TEXTURE_3D, f->env_on && !f->mobile ? r->body_tex : 0);
+    glUniform1f(rs_uloc(prog, "u_body_on"), f->env_on && !f->mobile ? 1.0f : 0.0f);
     rs_render_fine_uniforms(r, f, prog);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
     // Unbind what later passes render into (a bound sampler on an attached texture is a feedback loop).
     for (int i = RS_UNIT_DEPTH; i <= RS_UNIT_FINE_INDEX; i++) rs_render_bind_texture(i, 0);
     rs_render_bind_texture(RS_UNIT_REFLECT, 0);
+    glActiveTexture(GL_TEXTURE0 + RS_UNIT_BODY);
+    glBindTexture(GL_TEXTURE_3D, 0);
     rs_render_fine_unbind();
     return RS_OK;
 }

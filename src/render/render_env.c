@@ -403,12 +403,77 @@ void rs_render_env_uniforms(const rs_renderer *r, const rs_frame *f, GLuint prog
                       (const float (*)[3])r->env.lamp_color, RS_ENV_LAMPS, fwd, surround);
     for (int c = 0; c < 3; c++) surround[c] *= e;
     glUniform3fv(rs_uloc(prog, "u_env_surround"), 1, surround);
+    glUniform3fv(rs_uloc(prog, "u_body_lo"), 1, r->body_lo);
+    glUniform1f(rs_uloc(prog, "u_body_cell"), r->body_cell);
+    glUniform1i(rs_uloc(prog, "u_body_n"), RS_BODY_GRID);
 }
 
 void rs_render_env_release(rs_renderer *r)
 {
-    GLuint t[2] = {r->env_tex, r->lut_tex};
-    glDeleteTextures(2, t);
-    r->env_tex = r->lut_tex = 0;
+    GLuint t[3] = {r->env_tex, r->lut_tex, r->body_tex};
+    glDeleteTextures(3, t);
+    r->env_tex = r->lut_tex = r->body_tex = 0;
     r->env.on = false;
+}
+
+rs_result rs_render_env_body(rs_renderer *r, rs_error *err)
+{
+    if (r->body_tex) return RS_OK;
+    const rs_splat_cloud *c = r->cloud;
+    float ext = 0.0f;
+    for (int k = 0; k < 3; k++) ext = fmaxf(ext, c->hdr.bbox_max[k] - c->hdr.bbox_min[k]);
+    r->body_cell = fmaxf(ext, 1e-6f) / (RS_BODY_GRID - 1);
+    for (int k = 0; k < 3; k++) r->body_lo[k] = c->hdr.bbox_min[k];
+    // Per cell: the mean linear albedo and the summed normal of the splats in it.
+    const size_t cells = (size_t)RS_BODY_GRID * RS_BODY_GRID * RS_BODY_GRID;
+    float *acc = calloc(cells * 7, sizeof(float));
+    uint32_t *grid = calloc(cells, sizeof(uint32_t));
+    if (!acc || !grid) {
+        free(acc), free(grid);
+        return rs_fail(err, RS_ERR_NOMEM, "render: body grid: out of memory");
+    }
+    float lin[256];
+    for (int v = 0; v < 256; v++) lin[v] = rs_srgb_to_linear((float)v / 255.0f);
+    for (uint32_t i = 0; i < c->hdr.count; i++) {
+        int q[3];
+        for (int k = 0; k < 3; k++) q[k] = (int)floorf((c->pos[i][k] - r->body_lo[k]) / r->body_cell);
+        if (q[0] < 0 || q[1] < 0 || q[2] < 0 || q[0] >= RS_BODY_GRID || q[1] >= RS_BODY_GRID || q[2] >= RS_BODY_GRID) continue;
+        rs_splat s;
+        rs_splat_get(c, i, &s);
+        float *a = acc + 7 * (((size_t)q[2] * RS_BODY_GRID + (size_t)q[1]) * RS_BODY_GRID + (size_t)q[0]);
+        for (int k = 0; k < 3; k++) a[k] += lin[s.rgb[k]], a[3 + k] += c->normal[i][k];
+        a[6] += 1.0f;
+    }
+    // Packed in 32 bits: albedo 5:5:5, the normal octahedral 8:8, bit 31 set where the cell holds surface.
+    for (size_t v = 0; v < cells; v++) {
+        const float *a = acc + 7 * v;
+        float l = fabsf(a[3]) + fabsf(a[4]) + fabsf(a[5]);
+        if (a[6] <= 0.0f || l <= 0.0f) continue;
+        float ox = a[3] / l, oy = a[4] / l;
+        if (a[5] < 0.0f) {
+            float tx = (1.0f - fabsf(oy)) * (ox >= 0.0f ? 1.0f : -1.0f), ty = (1.0f - fabsf(ox)) * (oy >= 0.0f ? 1.0f : -1.0f);
+            ox = tx, oy = ty;
+        }
+        uint32_t w = 1u << 31;
+        for (int k = 0; k < 3; k++)
+            w |= (uint32_t)lrintf(RS_CLAMP(a[k] / a[6], 0.0f, 1.0f) * 31.0f) << (26 - 5 * k);
+        w |= (uint32_t)lrintf((ox * 0.5f + 0.5f) * 255.0f) << 8 | (uint32_t)lrintf((oy * 0.5f + 0.5f) * 255.0f);
+        grid[v] = w;
+    }
+    free(acc);
+    glGenTextures(1, &r->body_tex);
+    glBindTexture(GL_TEXTURE_3D, r->body_tex);
+    glTexStorage3D(GL_TEXTURE_3D, 1, GL_R32UI, RS_BODY_GRID, RS_BODY_GRID, RS_BODY_GRID);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, RS_BODY_GRID, RS_BODY_GRID, RS_BODY_GRID, GL_RED_INTEGER, GL_UNSIGNED_INT, grid);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_3D, 0);
+    free(grid);
+    rs_result res = rs_gl_check("render: body grid upload", err);
+    if (res != RS_OK) {
+        glDeleteTextures(1, &r->body_tex);
+        r->body_tex = 0;
+    }
+    return res;
 }

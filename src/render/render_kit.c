@@ -103,6 +103,7 @@ rs_result rs_render_program(rs_renderer *r, rs_prog kind, bool quads, GLuint *ou
     glUniform1i(rs_uloc(p, "u_color"), RS_UNIT_COLOR);
     glUniform1i(rs_uloc(p, "u_edges"), RS_UNIT_EDGES);
     glUniform1i(rs_uloc(p, "u_reflect"), RS_UNIT_REFLECT);
+    glUniform1i(rs_uloc(p, "u_body"), RS_UNIT_BODY);
     glUniform1f(rs_uloc(p, "u_has_ao"), (h->flags & RS_SPLAT_FLAG_AO) ? 1.0f : 0.0f);
     glUniform1f(rs_uloc(p, "u_has_bent"), (h->flags & RS_SPLAT_FLAG_BENT) ? 1.0f : 0.0f);
     r->prog[kind][q] = p;

@@ -40,6 +40,9 @@ void rs_render_shadow_release(rs_renderer *r);
 void rs_render_level_release(rs_renderer *r);
 void rs_render_pick_release(rs_renderer *r);
 void rs_render_env_release(rs_renderer *r);
+// The cloud as a coarse grid (built once, at the first frame under an environment): what a reflection that
+// leaves the frame meets (composite.frag.glsl body_seen).
+rs_result rs_render_env_body(rs_renderer *r, rs_error *err);
 void rs_render_fine_release(rs_renderer *r);
 
 #endif
