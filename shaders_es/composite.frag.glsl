@@ -311,14 +311,11 @@ bool body_seen(vec3 p, vec3 R, out vec3 L)
     for (int k = 0; k < 2 * u_body_n; k++, t += 0.7) {
         ivec3 q = ivec3(floor(o + d * t));
         if (any(lessThan(q, ivec3(0))) || any(greaterThanEqual(q, ivec3(u_body_n)))) return false;
-        uint w = texelFetch(u_body, q, 0).r;
-        if (w < 0x80000000u) continue;
-        vec2 e = vec2(float((w >> 8) & 255u), float(w & 255u)) / 255.0 * 2.0 - 1.0;
-        vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
-        if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
-        n = normalize(n);
+        uvec2 w = texelFetch(u_body, q, 0).rg;
+        if (w.x < 0x80000000u) continue;
+        vec3 n = rs_from_octahedral(unpackSnorm2x16(w.y));  // coded as a splat record's normal
         if (dot(n, d) > -0.1) continue;  // a cell seen from behind: the ray runs along or out of that surface
-        vec3 a = vec3(float((w >> 26) & 31u), float((w >> 21) & 31u), float((w >> 16) & 31u)) / 31.0;
+        vec3 a = vec3(float((w.x >> 20) & 1023u), float((w.x >> 10) & 1023u), float(w.x & 1023u)) / 1023.0;
         vec3 nv = normalize(n * mat3(u_inv_view)), h = p + R * (t * u_body_cell);
         L = a * (rs_env_irradiance(nv) + u_key_color * (max(dot(nv, u_key_dir), 0.0) * rs_shadow(h, nv))
                  + rs_env_lamp_irradiance(nv, rs_env_lamp_visibility(h, nv)));

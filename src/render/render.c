@@ -492,7 +492,7 @@ rs_result rs_render_frame(rs_renderer *r, const rs_view *view, rs_error *err)
     for (int i = 0; i < 2; i++) shadow_bytes += (size_t)r->shadow[i].size * (size_t)r->shadow[i].size * 4;
     shadow_bytes += (size_t)r->lamp_shadow.size * (size_t)r->lamp_shadow.size * 4 * RS_ENV_LAMPS;  // a layer each
     size_t pick_bytes = (size_t)r->pw * (size_t)r->ph * 8;
-    size_t body_bytes = r->body_tex ? (size_t)RS_BODY_GRID * RS_BODY_GRID * RS_BODY_GRID * 4 : 0;
+    size_t body_bytes = r->body_tex ? (size_t)RS_BODY_GRID * RS_BODY_GRID * RS_BODY_GRID * 8 : 0;
     r->stats.gpu_bytes = (size_t)r->cloud->hdr.count * 40 + target_bytes(r) + shadow_bytes + pick_bytes + body_bytes;
     r->stats.frame_ms = (rs_time_now() - t_start) * 1000.0;
     return RS_OK;

@@ -427,7 +427,7 @@ rs_result rs_render_env_body(rs_renderer *r, rs_error *err)
     // Per cell: the mean linear albedo and the summed normal of the splats in it.
     const size_t cells = (size_t)RS_BODY_GRID * RS_BODY_GRID * RS_BODY_GRID;
     float *acc = calloc(cells * 7, sizeof(float));
-    uint32_t *grid = calloc(cells, sizeof(uint32_t));
+    uint32_t *grid = calloc(cells * 2, sizeof(uint32_t));
     if (!acc || !grid) {
         free(acc), free(grid);
         return rs_fail(err, RS_ERR_NOMEM, "render: body grid: out of memory");
@@ -444,28 +444,23 @@ rs_result rs_render_env_body(rs_renderer *r, rs_error *err)
         for (int k = 0; k < 3; k++) a[k] += lin[s.rgb[k]], a[3 + k] += c->normal[i][k];
         a[6] += 1.0f;
     }
-    // Packed in 32 bits: albedo 5:5:5, the normal octahedral 8:8, bit 31 set where the cell holds surface.
+    // Per cell, RG32UI: bit 31 set where the cell holds surface, the albedo 10:10:10; the normal coded as
+    // a splat record's (octahedral snorm16 x 2).
     for (size_t v = 0; v < cells; v++) {
         const float *a = acc + 7 * v;
-        float l = fabsf(a[3]) + fabsf(a[4]) + fabsf(a[5]);
-        if (a[6] <= 0.0f || l <= 0.0f) continue;
-        float ox = a[3] / l, oy = a[4] / l;
-        if (a[5] < 0.0f) {
-            float tx = (1.0f - fabsf(oy)) * (ox >= 0.0f ? 1.0f : -1.0f), ty = (1.0f - fabsf(ox)) * (oy >= 0.0f ? 1.0f : -1.0f);
-            ox = tx, oy = ty;
-        }
+        if (a[6] <= 0.0f || !(fabsf(a[3]) + fabsf(a[4]) + fabsf(a[5]) > 0.0f)) continue;
         uint32_t w = 1u << 31;
         for (int k = 0; k < 3; k++)
-            w |= (uint32_t)lrintf(RS_CLAMP(a[k] / a[6], 0.0f, 1.0f) * 31.0f) << (26 - 5 * k);
-        w |= (uint32_t)lrintf((ox * 0.5f + 0.5f) * 255.0f) << 8 | (uint32_t)lrintf((oy * 0.5f + 0.5f) * 255.0f);
-        grid[v] = w;
+            w |= (uint32_t)lrintf(RS_CLAMP(a[k] / a[6], 0.0f, 1.0f) * 1023.0f) << (20 - 10 * k);
+        grid[2 * v] = w;
+        grid[2 * v + 1] = rs_splat_encode_normal(a + 3);
     }
     free(acc);
     glGenTextures(1, &r->body_tex);
     glBindTexture(GL_TEXTURE_3D, r->body_tex);
-    glTexStorage3D(GL_TEXTURE_3D, 1, GL_R32UI, RS_BODY_GRID, RS_BODY_GRID, RS_BODY_GRID);
+    glTexStorage3D(GL_TEXTURE_3D, 1, GL_RG32UI, RS_BODY_GRID, RS_BODY_GRID, RS_BODY_GRID);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, RS_BODY_GRID, RS_BODY_GRID, RS_BODY_GRID, GL_RED_INTEGER, GL_UNSIGNED_INT, grid);
+    glTexSubImage3D(GL_TEXTURE_3D, 0, 0, 0, 0, RS_BODY_GRID, RS_BODY_GRID, RS_BODY_GRID, GL_RG_INTEGER, GL_UNSIGNED_INT, grid);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_3D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glBindTexture(GL_TEXTURE_3D, 0);

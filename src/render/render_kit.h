@@ -276,7 +276,7 @@ struct rs_renderer {
 
     rs_render_env env;          // render_env.c
     GLuint env_tex, lut_tex;
-    GLuint body_tex;            // render_env.c rs_render_env_body: the cloud's grid, RS_BODY_GRID^3 R32UI
+    GLuint body_tex;            // render_env.c rs_render_env_body: the cloud's grid, RS_BODY_GRID^3 RG32UI
     float body_lo[3], body_cell; // the grid's corner and cell size, model units
 
     // Incremental frames (render.c): the last full frame's view and what it drew; makeup uploads since
