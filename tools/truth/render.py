@@ -7,7 +7,10 @@
 # environment turned and scaled as rouge sees it; splats.f32: the splats' regions) and sss_calibrate.py's
 # (sss.json: the subsurface radius that scatters like rouge's skin profile).
 # DATA_DIR: ../shared/data/leeperrysmith (head_mesh.ply, color.png, normal.png: what face.rsf was made from).
-# Writes OUT_DIR/ENV_VIEW.rtf for every view (the uncompressed fixture, tests/fixtures/truth/README.md).
+# Writes OUT_DIR/ENV_VIEW.rtf for every view (the uncompressed fixture, tests/fixtures/truth/README.md); with
+# TRUTH_PASSES=1 in the environment also OUT_DIR/ENV_VIEW_passes.npz, Cycles' light passes (DiffDir, DiffInd,
+# DiffCol, GlossDir, GlossInd, GlossCol: premultiplied RGBA, rows from the top) and its ambient occlusion (AO,
+# cosine-weighted, unbounded distance), to tell which part of the light differs from rouge's.
 #
 # The scene: the mesh in rouge's model coordinates (+y up, the face towards +z; Blender's own up axis plays no
 # part), its vertex normals perturbed by the tangent-space normal map as the splats' were; a Principled BSDF
@@ -33,6 +36,8 @@ SSS = json.load(open(os.path.join(scene_dir, "sss.json")))  # sss_calibrate.py
 size = S["size"]
 env = next(e for e in S["envs"] if e["name"] == env_name)
 F0_SKIN = 0.028          # skin, n = 1.4 (rouge's RS_F0_SKIN)
+PASSES = ("DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol", "AO") \
+    if os.environ.get("TRUTH_PASSES") == "1" else ()
 
 # Label values of the fixture's label plane (tests/test_truth.c reads them).
 LABEL_REGION0 = 1        # 1 + region index of the .rsf table (nearest splat)
@@ -235,7 +240,12 @@ def setup_render():
     fo.format.color_depth = "32"
     fo.format.color_mode = "RGBA"
     fo.file_slots.clear()
-    for name in ("Image", "Position", "Normal", "Depth"):
+    if PASSES:
+        for p in ("diffuse_direct", "diffuse_indirect", "diffuse_color", "glossy_direct", "glossy_indirect",
+                  "glossy_color", "ambient_occlusion"):
+            setattr(vl, "use_pass_" + p, True)
+        sc.world.light_settings.distance = 1e4   # the whole sky, as rouge-pack's occlusion
+    for name in ("Image", "Position", "Normal", "Depth") + PASSES:
         fo.file_slots.new(name)
         nt.links.new(rl.outputs[name], fo.inputs[name])
     return fo
@@ -355,7 +365,10 @@ def main():
         sc.cycles.samples = samples
         bpy.ops.render.render(write_still=False)
         px = {n: read_exr(os.path.join(out_dir, "%s%s0001.exr" % (prefix, n)))
-              for n in ("Image", "Position", "Normal", "Depth")}
+              for n in ("Image", "Position", "Normal", "Depth") + PASSES}
+        if PASSES:
+            np.savez_compressed(os.path.join(out_dir, "%s_%s_passes.npz" % (env_name, view["name"])),
+                                **{n: px[n] for n in PASSES})
         # The albedo: the same camera, the emission-only material, 16 samples (pixel coverage only).
         vl.material_override = albedo
         sc.cycles.samples = 16

@@ -3,6 +3,7 @@
 # environment x view with Blender Cycles and writes tests/fixtures/truth/ENV_VIEW.rtf.zst. Slow (about
 # TRUTH_SAMPLES x 0.4 s of CPU a view, plus 2 CPU-minutes calibrating the subsurface); never part of make test.
 #   sh tools/truth/truth.sh BUILD_DIR        TRUTH_SAMPLES (1024), TRUTH_ENVS ("studio daylight office sunset")
+# TRUTH_PASSES=1 also writes BUILD_DIR/truth/ENV_VIEW_passes.npz, the light passes (render.py).
 set -eu
 build=${1:-build}
 samples=${TRUTH_SAMPLES:-1024}
