@@ -58,7 +58,7 @@ enum {
     RS_UNIT_COLOR,       // the composite's picture before its contours are anti-aliased (u_color)
     RS_UNIT_EDGES,       // the depth steps in it (u_edges, RG8)
     RS_UNIT_REFLECT,     // the face blocking the mirror direction (u_reflect, RGBA32UI, half size)
-    RS_UNIT_BODY,        // the cloud as a coarse grid for reflections that leave the frame (u_body, R32UI 3D)
+    RS_UNIT_BODY,        // the cloud as a coarse grid for reflections that leave the frame (u_body, RG32UI 3D)
     RS_UNIT_COUNT
 };
 _Static_assert(RS_UNIT_COUNT <= RS_RENDER_TEXTURE_UNITS, "render.h's RS_RENDER_TEXTURE_UNITS");
@@ -158,10 +158,10 @@ typedef struct rs_diffusion_level {
 // N.V on, a grid of taps below it; the mobile pipeline's grid has no taps across the plane of incidence.
 // Mobile: ~3.5 ms less of a 512^2 frame on llvmpipe; 0.0-0.2 dB further from the reference (docs/mobile.md).
 #define RS_ENV_ONE_LOOKUP_REFERENCE 0.6f
+#define RS_ENV_ONE_LOOKUP_MOBILE 0.55f
 // The reference's grid of the cloud for reflections that leave the frame: cells per side over the cloud's
 // largest extent (the bundled bust, ~0.3 m: ~5 mm cells; 96 measured the same against the path tracer).
 #define RS_BODY_GRID 64
-#define RS_ENV_ONE_LOOKUP_MOBILE 0.55f
 // The key's map: at most this size, and no larger than the output needs (render_shadow.c map_size).
 #define RS_SHADOW_SIZE_REFERENCE 4096
 #define RS_SHADOW_SIZE_MOBILE 2048
