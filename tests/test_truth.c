@@ -96,14 +96,19 @@ static const measured was[] = {
     // 1.49 / 1.38 -> 1.44 / 1.38, sunset 0.88 / 0.97 -> 0.86 / 0.92; every band up (daylight front 0.9984
     // -> 0.9999, under the jaw 0.9975 -> 1.0104; studio 3/4 1.0002 -> 1.0017); under the chin rouge now a
     // little brighter than the reference (0.940-1.020); studio 3/4's ears 0.981 -> 0.963.
-    {"studio", "front", 1.28, {1.002, 1.042, 0.976, 1.016, 1.008}, 1.152, 0.25},
-    {"studio", "threequarter", 1.56, {0.996, 1.058, 0.963, 1.029, 1.005}, 1.002, 0.08},
-    {"daylight", "front", 1.11, {0.966, 1.059, 1.033, 1.019, 1.032}, 1.000, 0.00},
-    {"daylight", "threequarter", 1.12, {0.940, 1.061, 0.995, 1.009, 1.029}, 1.005, 0.00},
-    {"office", "front", 1.44, {1.020, 1.050, 1.045, 1.007, 0.990}, 1.059, 0.12},
-    {"office", "threequarter", 1.38, {0.945, 1.051, 1.020, 0.989, 0.968}, 1.068, 0.03},
-    {"sunset", "front", 0.86, {0.986, 1.066, 1.018, 1.020, 1.027}, 1.016, 0.01},
-    {"sunset", "threequarter", 0.92, {0.989, 1.067, 0.997, 1.012, 1.024}, 1.010, 0.00},
+    // Fixtures re-rendered as the mean of two independent renders (Cycles seeds 1 and 2, 1024 samples
+    // each; tools/truth/render.py SEEDS): rouge unchanged, the reference's noise halved in variance: dE
+    // 0.04-0.08 lower in every view (studio 1.28 / 1.56 -> 1.22 / 1.48, daylight 1.11 / 1.12 -> 1.07 /
+    // 1.07, office 1.44 / 1.38 -> 1.40 / 1.32, sunset 0.86 / 0.92 -> 0.83 / 0.87), ratios and bands within
+    // 0.007 (daylight front's band 0.9999 against both; against seed 2 alone 0.9983).
+    {"studio", "front", 1.22, {1.000, 1.041, 0.972, 1.016, 1.006}, 1.154, 0.24},
+    {"studio", "threequarter", 1.48, {0.995, 1.055, 0.960, 1.028, 1.003}, 1.003, 0.08},
+    {"daylight", "front", 1.07, {0.963, 1.057, 1.030, 1.017, 1.031}, 1.000, 0.00},
+    {"daylight", "threequarter", 1.07, {0.940, 1.057, 0.993, 1.009, 1.028}, 1.006, 0.00},
+    {"office", "front", 1.40, {1.020, 1.051, 1.041, 1.007, 0.988}, 1.060, 0.12},
+    {"office", "threequarter", 1.32, {0.945, 1.044, 1.016, 0.987, 0.967}, 1.071, 0.02},
+    {"sunset", "front", 0.83, {0.985, 1.065, 1.016, 1.020, 1.027}, 1.016, 0.01},
+    {"sunset", "threequarter", 0.87, {0.989, 1.066, 0.997, 1.012, 1.025}, 1.010, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87

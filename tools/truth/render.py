@@ -1,12 +1,15 @@
 # render.py — the path-traced reference of the bundled head: Blender Cycles (Debian's blender 3.4), run by
 # tools/truth/truth.sh as
 #
-#   blender -b --factory-startup --python tools/truth/render.py -- SCENE_DIR DATA_DIR ENV SAMPLES OUT_DIR
+#   blender -b --factory-startup --python tools/truth/render.py -- SCENE_DIR DATA_DIR ENV SAMPLES OUT_DIR [SEEDS]
 #
 # SCENE_DIR: rouge-truth-scene's output (scene.json: rouge's cameras, region table; env_ENV.hdr: the
 # environment turned and scaled as rouge sees it; splats.f32: the splats' regions) and sss_calibrate.py's
 # (sss.json: the subsurface radius that scatters like rouge's skin profile).
 # DATA_DIR: ../shared/data/leeperrysmith (head_mesh.ply, color.png, normal.png: what face.rsf was made from).
+# SEEDS (default 1): each view is the mean of that many independent renders (Cycles seeds 1..SEEDS) of SAMPLES
+# samples a pixel. Adaptive sampling stops a pixel at its noise threshold, so one render of twice the samples
+# leaves most of the skin as noisy as before; the mean of two independent ones halves every pixel's variance.
 # Writes OUT_DIR/ENV_VIEW.rtf for every view (the uncompressed fixture, tests/fixtures/truth/README.md); with
 # TRUTH_PASSES=1 in the environment also OUT_DIR/ENV_VIEW_passes.npz, Cycles' light passes (DiffDir, DiffInd,
 # DiffCol, GlossDir, GlossInd, GlossCol: premultiplied RGBA, rows from the top) and its ambient occlusion (AO,
@@ -31,6 +34,7 @@ from mathutils.kdtree import KDTree
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 scene_dir, data_dir, env_name, samples, out_dir = argv[0], argv[1], argv[2], int(argv[3]), argv[4]
+seeds = int(argv[5]) if len(argv) > 5 else 1
 S = json.load(open(os.path.join(scene_dir, "scene.json")))
 SSS = json.load(open(os.path.join(scene_dir, "sss.json")))  # sss_calibrate.py
 size = S["size"]
@@ -218,7 +222,6 @@ def setup_render():
     c.sample_clamp_indirect = 0.0
     c.pixel_filter_type = "BOX"      # each pixel the mean over its own area
     c.filter_width = 1.0
-    c.seed = 1
     sc.render.threads_mode = "FIXED"
     sc.render.threads = 2
     sc.render.resolution_x = sc.render.resolution_y = size
@@ -332,7 +335,7 @@ def labels(alpha, pos, nrm, depth, splat_tree, splat_region):
 
 def write_fixture(path, view, rgb, alb, alpha, lab):
     head = struct.pack("<8sII16s16sffffI", b"RSTRUTH1", size, size, env_name.encode(), view["name"].encode(),
-                       view["yaw"], view["pitch"], env["scale"], float(samples), 0)
+                       view["yaw"], view["pitch"], env["scale"], float(samples * seeds), 0)
     with open(path, "wb") as f:
         f.write(head)
         f.write(rgb.astype("<f2").tobytes())
@@ -363,9 +366,16 @@ def main():
         vl = sc.view_layers[0]
         vl.material_override = None
         sc.cycles.samples = samples
-        bpy.ops.render.render(write_still=False)
-        px = {n: read_exr(os.path.join(out_dir, "%s%s0001.exr" % (prefix, n)))
-              for n in ("Image", "Position", "Normal", "Depth") + PASSES}
+        px = {}
+        for seed in range(1, seeds + 1):
+            sc.cycles.seed = seed
+            bpy.ops.render.render(write_still=False)
+            # The light (premultiplied) is averaged over the seeds; the geometry is the first render's.
+            for n in ("Image",) + PASSES + (("Position", "Normal", "Depth") if seed == 1 else ()):
+                a = read_exr(os.path.join(out_dir, "%s%s0001.exr" % (prefix, n)))
+                px[n] = px[n] + a if seed > 1 and n in ("Image",) + PASSES else a
+        for n in ("Image",) + PASSES:
+            px[n] /= seeds
         if PASSES:
             np.savez_compressed(os.path.join(out_dir, "%s_%s_passes.npz" % (env_name, view["name"])),
                                 **{n: px[n] for n in PASSES})

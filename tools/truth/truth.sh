@@ -1,12 +1,15 @@
 #!/bin/sh
 # make truth: the path-traced reference of the bundled head (tests/fixtures/truth/README.md). Renders every bundled
 # environment x view with Blender Cycles and writes tests/fixtures/truth/ENV_VIEW.rtf.zst. Slow (about
-# TRUTH_SAMPLES x 0.4 s of CPU a view, plus 2 CPU-minutes calibrating the subsurface); never part of make test.
-#   sh tools/truth/truth.sh BUILD_DIR        TRUTH_SAMPLES (1024), TRUTH_ENVS ("studio daylight office sunset")
+# TRUTH_SAMPLES x TRUTH_SEEDS x 0.4 s of CPU a view, plus 2 CPU-minutes calibrating the subsurface); never part
+# of make test. Each view is the mean of TRUTH_SEEDS independent renders of TRUTH_SAMPLES (render.py).
+#   sh tools/truth/truth.sh BUILD_DIR        TRUTH_SAMPLES (1024), TRUTH_SEEDS (2),
+#                                            TRUTH_ENVS ("studio daylight office sunset")
 # TRUTH_PASSES=1 also writes BUILD_DIR/truth/ENV_VIEW_passes.npz, the light passes (render.py).
 set -eu
 build=${1:-build}
 samples=${TRUTH_SAMPLES:-1024}
+seeds=${TRUTH_SEEDS:-2}
 envs=${TRUTH_ENVS:-studio daylight office sunset}
 size=256
 data=../shared/data/leeperrysmith
@@ -36,9 +39,9 @@ if ! nice -n 15 blender -b --factory-startup --python-exit-code 1 --python tools
 fi
 grep '^sss_calibrate: radius' "$out/sss.log"
 for env in $envs; do
-    echo "make truth: $env ($samples samples a pixel)"
+    echo "make truth: $env ($seeds x $samples samples a pixel)"
     if ! nice -n 15 blender -b --factory-startup --python-exit-code 1 --python tools/truth/render.py -- \
-            "$out" "$data" "$env" "$samples" "$out" >"$out/$env.log" 2>&1; then
+            "$out" "$data" "$env" "$samples" "$out" "$seeds" >"$out/$env.log" 2>&1; then
         tail -n 20 "$out/$env.log" >&2
         echo "make truth: blender failed on $env (log: $out/$env.log)" >&2
         exit 1
