@@ -7,7 +7,9 @@
 // what lights the skin around a hollow, taken as the face's front surface on average (u_env_surround,
 // render_env.c: its mean irradiance, SH and the environment's light, as a camera in front sees it). So a
 // crease gets light in the skin's colour (red-brown under red-brown skin), and an underside facing a dark
-// floor (under the jaw) is lit by the skin that faces the light.
+// floor (under the jaw) is lit by the skin that faces the light. The composite then relights each pixel's
+// share with the light of the walls it sees on screen (composite.frag.glsl surround_seen): the splats' pass
+// cannot look at its neighbours.
 uniform vec3 u_env_surround;
 
 // The fit's cubic coefficients for the cavity's albedo (linear RGB): visibility (a v^2 + b v + c) v.
@@ -26,10 +28,17 @@ vec3 rs_multibounce(float v, vec3 albedo)
     return max(vec3(v), ((v * a + b) * v + c) * v);
 }
 
-// Irradiance that reaches a point of visibility v from the skin around it (albedo: its colour).
+// Irradiance that reaches a point of visibility v from the skin around it (albedo: its colour), that skin
+// lit by `surround`.
+vec3 rs_bounce_lit(float v, vec3 albedo, vec3 surround)
+{
+    return (rs_multibounce(v, clamp(albedo, 0.0, 1.0)) - v) * surround;
+}
+
+// The same, the skin around lit as the face's front is on average (what the splats get).
 vec3 rs_bounce(float v, vec3 albedo)
 {
-    return (rs_multibounce(v, clamp(albedo, 0.0, 1.0)) - v) * u_env_surround;
+    return rs_bounce_lit(v, albedo, u_env_surround);
 }
 
 // The radiance of that skin in the directions the occlusion hides: rs_bounce over the hidden share (1 - v),

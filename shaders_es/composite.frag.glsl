@@ -249,6 +249,12 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
     return 1.0 - edge_on * (1.0 - smoothstep(0.5 * u_contour_reach, u_contour_reach, gap));
 }
 
+// How many pixels a millimetre at view-space point p spans (u_contour_reach is 20 mm).
+float pixels_per_mm(vec3 p)
+{
+    return u_proj[1][1] * 0.5 * u_viewport.y / -p.z * u_contour_reach / 20.0;
+}
+
 // Whether the face itself blocks the mirror direction R (reflect.frag.glsl's march, at half size),
 // averaged over the pixel and 8 around it at 1 mm (at least 4 px) that lie on its surface (within 1 mm of
 // its tangent plane and 5 mm of it) and mirror about its way: one pixel's march ends in a sharp edge where
@@ -258,8 +264,8 @@ float contour_open(vec3 p, vec3 N, float ndotv, float edge_on, inout ivec2 hit)
 void reflection_near(ivec2 px, vec3 p, vec3 N, vec3 R, out float open, out bool left, out vec3 blocked)
 {
     open = 1.0, blocked = vec3(0.0), left = false;
-    // 1 mm here in pixels (u_contour_reach is 20 mm), within 4..16 px (2..8 of the march's).
-    float mm = clamp(u_proj[1][1] * 0.5 * u_viewport.y / -p.z * u_contour_reach / 20.0, 4.0, 16.0);
+    // 1 mm here in pixels, within 4..16 px (2..8 of the march's).
+    float mm = clamp(pixels_per_mm(p), 4.0, 16.0);
     vec2 half_size = vec2(textureSize(u_reflect, 0));
     float w_sum = 0.0, o_sum = 0.0, w_left = 0.0;
     // The samples' rays: the unprojected point at the near plane is affine in the pixel's NDC (h0 + hx x
@@ -322,6 +328,43 @@ bool body_seen(vec3 p, vec3 R, out vec3 L)
         return true;
     }
     return false;
+}
+
+// What lights the walls of this point's hollow, where the camera sees them: the irradiance (D, as skin_at
+// reads it) of the visible surface within SURROUND_MM that lies above the point's tangent plane and faces
+// it, each sample weighted by how squarely the two see each other and faded out over the last half of the
+// reach (a sample stepping across a hard cut showed as a crease in the light). Samples on a sunflower
+// spiral, even over the disk. w: the weights' sum (0: no wall seen, the face's mean front light returned).
+// The bounce cubic (bounce.glsl) lit every hollow with that mean: a nostril's inside like a sunlit cheek,
+// the shadowed side's ear like the lit side's (issue 22: the darkest tenth of a front view 1.00-1.09 of the
+// path tracer's on the side the key does not reach, 1.00-1.05 with this).
+#define SURROUND_MM 12.0
+#define SURROUND_SAMPLES 16
+vec3 surround_seen(ivec2 px, vec3 p, vec3 N, out float w)
+{
+    vec3 sum = vec3(0.0);
+    w = 0.0;
+    float r_px = pixels_per_mm(p) * SURROUND_MM, reach = SURROUND_MM * u_contour_reach / 20.0;
+    ivec2 hi = ivec2(u_viewport) - 1;
+    for (int i = 0; i < SURROUND_SAMPLES; i++) {
+        float a = float(i) * 2.3999632, r = max(r_px * sqrt((float(i) + 0.5) / float(SURROUND_SAMPLES)), 1.0);
+        ivec2 q = clamp(px + ivec2(round(vec2(cos(a), sin(a)) * r)), ivec2(0), hi);
+        vec3 pq;
+        if (!rs_visible_point_at(q, pq)) continue;
+        vec4 t = texelFetch(u_attr0, q, 0);
+        if (t.a <= u_min_weight) continue;
+        vec3 d = pq - p;
+        float l = length(d);
+        if (l < 1e-6 || l >= reach) continue;
+        d /= l;
+        vec3 nq = normalize(texelFetch(u_attr1, q, 0).xyz / t.a * 2.0 - 1.0);
+        float k = max(dot(N, d), 0.0) * max(-dot(nq, d), 0.0) * (1.0 - smoothstep(0.5 * reach, reach, l));
+        if (k <= 0.0) continue;
+        vec4 dq = texelFetch(u_diffuse, q, 0) * u_diffuse_scale;
+        sum += k * (dq.rgb + u_delta_weight * dq.a);
+        w += k;
+    }
+    return w > 0.0 ? sum / w : u_env_surround;
 }
 
 // How far the normal turns across this pixel (radians): the larger of its changes to the next pixel right
@@ -409,7 +452,7 @@ void main()
                + u_ambient;
         // The makeup's clear coat: the same lobe family, smooth (m 0.1), F0 0.04, untinted, on top.
         const float mc = 0.1;
-        vec3 C = vec3(0.0), Eb = vec3(0.0), vis = vec3(1.0);
+        vec3 C = vec3(0.0), Eb = vec3(0.0), Eb_walls = vec3(0.0), vis = vec3(1.0);
         float spread = 0.0;
         if (coat > 0.0)
             C = u_key_color * (rs_ksk_lobe(N, u_key_dir, V, sqrt(mc * mc + u_key_widen * u_key_widen), RS_F0_COAT)
@@ -455,6 +498,18 @@ void main()
             // The per-pixel share of the diffuse gets the bounce as the splats do (irradiance.vert.glsl),
             // in the colour of the surface as painted: a lipstick's crease bounces lipstick.
             Eb = rs_bounce(ao, A);
+            // Where the point is occluded enough for its bounce to show (above 0.98 it is under 1 % of its
+            // light), the bounce is lit by the walls it sees (surround_seen), faded in from 0.98 to 0.95
+            // and by how much wall was found; Eb_walls, the difference, relights the drawn levels' share
+            // (D holds the splats' bounce, lit by the mean) as Eb does the per-pixel share.
+            if (ao < 0.98) {
+                float ws;
+                vec3 Es = surround_seen(px, p, N, ws);
+                Es = mix(u_env_surround, Es, smoothstep(0.0, 0.5, ws) * smoothstep(0.98, 0.95, ao));
+                vec3 lit = rs_bounce_lit(ao, A, Es);
+                Eb_walls = lit - Eb;
+                Eb = lit;
+            }
             // The lobe's share the occlusion hides (1 - ao) reflects that skin too, not black: Eb is its
             // radiance over the hidden share, (1 - ao) L_skin, so that share adds Eb times the lobe's albedo
             // (under the jaw: the lit neck; its shares below come to 1 with so and the blocked ones times ao).
@@ -496,7 +551,7 @@ void main()
             float lc = mix(le, clamp(le, 0.8 * es, 1.25 * es), edge_on);
             Ed = le > 1e-6 ? E * (lc / le) : vec3(lc);
         }
-        vec3 Dd = D.rgb * u_diffuse_scale + u_delta_weight * Ed;
+        vec3 Dd = D.rgb * u_diffuse_scale + u_delta_weight * Ed + (vec3(1.0) - u_delta_weight) * Eb_walls;
         // Across a fold (the alar groove, a lid crease) the drawn levels' widest, reddest Gaussians gather
         // light from the lit side of the groove; seen edge-on, that bleed reads as a thin red line. There
         // D's red is held within 1.25 x its green, relative to the light's own colour (El: a sunset's

@@ -101,14 +101,19 @@ static const measured was[] = {
     // 0.04-0.08 lower in every view (studio 1.28 / 1.56 -> 1.22 / 1.48, daylight 1.11 / 1.12 -> 1.07 /
     // 1.07, office 1.44 / 1.38 -> 1.40 / 1.32, sunset 0.86 / 0.92 -> 0.83 / 0.87), ratios and bands within
     // 0.007 (daylight front's band 0.9999 against both; against seed 2 alone 0.9983).
-    {"studio", "front", 1.22, {1.000, 1.041, 0.972, 1.016, 1.006}, 1.154, 0.24},
-    {"studio", "threequarter", 1.48, {0.995, 1.055, 0.960, 1.028, 1.003}, 1.003, 0.08},
-    {"daylight", "front", 1.07, {0.963, 1.057, 1.030, 1.017, 1.031}, 1.000, 0.00},
-    {"daylight", "threequarter", 1.07, {0.940, 1.057, 0.993, 1.009, 1.028}, 1.006, 0.00},
-    {"office", "front", 1.40, {1.020, 1.051, 1.041, 1.007, 0.988}, 1.060, 0.12},
-    {"office", "threequarter", 1.32, {0.945, 1.044, 1.016, 0.987, 0.967}, 1.071, 0.02},
-    {"sunset", "front", 0.83, {0.985, 1.065, 1.016, 1.020, 1.027}, 1.016, 0.01},
-    {"sunset", "threequarter", 0.87, {0.989, 1.066, 0.997, 1.012, 1.025}, 1.010, 0.00},
+    // The bounce lit by the walls each occluded pixel sees (composite.frag.glsl surround_seen) instead of
+    // the face's mean front light: dE studio 1.22 / 1.48 -> 1.19 / 1.46, daylight 1.07 / 1.07 -> 1.06 /
+    // 1.03, office 1.40 / 1.32 -> 1.40 / 1.31, sunset 0.83 / 0.87 -> 0.83 / 0.86; every band up (daylight
+    // front 0.9999 -> 1.0010); eye sockets and ears darker against the reference (daylight front 1.031 ->
+    // 1.054, 1.030 -> 1.038; studio 3/4's ears 0.960 -> 0.986).
+    {"studio", "front", 1.19, {1.000, 1.041, 0.979, 1.016, 1.011}, 1.154, 0.21},
+    {"studio", "threequarter", 1.46, {0.993, 1.054, 0.986, 1.036, 1.015}, 1.005, 0.00},
+    {"daylight", "front", 1.06, {0.963, 1.060, 1.038, 1.019, 1.054}, 1.001, 0.00},
+    {"daylight", "threequarter", 1.03, {0.938, 1.059, 1.022, 1.015, 1.049}, 1.008, 0.00},
+    {"office", "front", 1.40, {1.018, 1.056, 1.049, 1.009, 1.020}, 1.061, 0.13},
+    {"office", "threequarter", 1.31, {0.944, 1.048, 1.035, 0.991, 0.984}, 1.072, 0.02},
+    {"sunset", "front", 0.83, {0.985, 1.067, 1.022, 1.021, 1.034}, 1.016, 0.01},
+    {"sunset", "threequarter", 0.86, {0.988, 1.067, 1.015, 1.017, 1.034}, 1.011, 0.00},
 };
 #define GOAL_DELTA_E 2.0
 #define GOAL_RATIO_LO 0.87
