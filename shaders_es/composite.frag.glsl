@@ -332,22 +332,23 @@ bool body_seen(vec3 p, vec3 R, out vec3 L)
 
 // What lights the walls of this point's hollow, where the camera sees them: the irradiance (D, as skin_at
 // reads it) of the visible surface within SURROUND_MM that lies above the point's tangent plane and faces
-// it, each sample weighted by how squarely the two see each other and faded out over the last half of the
-// reach (a sample stepping across a hard cut showed as a crease in the light). Samples on a sunflower
-// spiral, even over the disk. w: the weights' sum (0: no wall seen, the face's mean front light returned).
+// it, u_surround_samples points on a sunflower spiral even over the disk, each weighted by how squarely the
+// two see each other and faded out over the last half of the reach (a sample stepping across a hard cut
+// showed as a crease in the light). w: the weights' sum (0: no wall seen; the face's mean front light
+// returned).
 // The bounce cubic (bounce.glsl) lit every hollow with that mean: a nostril's inside like a sunlit cheek,
 // the shadowed side's ear like the lit side's (issue 22: the darkest tenth of a front view 1.00-1.09 of the
 // path tracer's on the side the key does not reach, 1.00-1.05 with this).
 #define SURROUND_MM 12.0
-#define SURROUND_SAMPLES 16
+uniform int u_surround_samples;  // 16 (reference); 0: the mean light (mobile)
 vec3 surround_seen(ivec2 px, vec3 p, vec3 N, out float w)
 {
     vec3 sum = vec3(0.0);
     w = 0.0;
     float r_px = pixels_per_mm(p) * SURROUND_MM, reach = SURROUND_MM * u_contour_reach / 20.0;
     ivec2 hi = ivec2(u_viewport) - 1;
-    for (int i = 0; i < SURROUND_SAMPLES; i++) {
-        float a = float(i) * 2.3999632, r = max(r_px * sqrt((float(i) + 0.5) / float(SURROUND_SAMPLES)), 1.0);
+    for (int i = 0; i < u_surround_samples; i++) {
+        float a = float(i) * 2.3999632, r = max(r_px * sqrt((float(i) + 0.5) / float(u_surround_samples)), 1.0);
         ivec2 q = clamp(px + ivec2(round(vec2(cos(a), sin(a)) * r)), ivec2(0), hi);
         vec3 pq;
         if (!rs_visible_point_at(q, pq)) continue;
@@ -502,7 +503,7 @@ void main()
             // light), the bounce is lit by the walls it sees (surround_seen), faded in from 0.98 to 0.95
             // and by how much wall was found; Eb_walls, the difference, relights the drawn levels' share
             // (D holds the splats' bounce, lit by the mean) as Eb does the per-pixel share.
-            if (ao < 0.98) {
+            if (ao < 0.98 && u_surround_samples > 0) {
                 float ws;
                 vec3 Es = surround_seen(px, p, N, ws);
                 Es = mix(u_env_surround, Es, smoothstep(0.0, 0.5, ws) * smoothstep(0.98, 0.95, ao));

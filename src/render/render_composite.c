@@ -115,6 +115,10 @@ rs_result rs_render_composite(rs_renderer *r, const rs_frame *f, rs_error *err)
     glActiveTexture(GL_TEXTURE0 + RS_UNIT_BODY);
     glBindTexture(GL_TEXTURE_3D, f->env_on && !f->mobile ? r->body_tex : 0);
     glUniform1f(rs_uloc(prog, "u_body_on"), f->env_on && !f->mobile ? 1.0f : 0.0f);
+    // The walls a hollow's bounce reads (composite.frag.glsl surround_seen). None on mobile: its bounce keeps
+    // the face's mean light (8 samples cost llvmpipe ~5 ms of a 512^2 frame, the environment's budget there
+    // being ~15 %, issue 12; docs/mobile.md).
+    glUniform1i(rs_uloc(prog, "u_surround_samples"), f->mobile ? 0 : 16);
     rs_render_fine_uniforms(r, f, prog);
     glBindVertexArray(r->vao_empty);
     glDrawArrays(GL_TRIANGLES, 0, 3);
